@@ -1,0 +1,25 @@
+# Every dependency is a Debian 12 package (see README, "Dependencies").
+find_package(Threads REQUIRED)
+find_package(TBB 2021 REQUIRED)
+find_package(zstd 1.5 REQUIRED)
+find_package(glm REQUIRED)
+find_package(CLI11 2.1 REQUIRED)
+find_package(nlohmann_json 3.10 REQUIRED)
+find_package(PNG REQUIRED)
+find_package(OpenEXR 3.1 REQUIRED)
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash>=0.8)
+pkg_check_modules(EPOXY REQUIRED IMPORTED_TARGET epoxy>=1.5)
+
+# OpenVDB 10 ships a Find module, not a config package.
+find_path(_flipscope_openvdb_cmake FindOpenVDB.cmake
+  PATHS /usr/lib/x86_64-linux-gnu/cmake/OpenVDB /usr/lib/cmake/OpenVDB /usr/local/lib/cmake/OpenVDB
+  REQUIRED)
+list(APPEND CMAKE_MODULE_PATH "${_flipscope_openvdb_cmake}")
+find_package(OpenVDB 10 REQUIRED COMPONENTS openvdb)
+
+if(TARGET zstd::libzstd_shared)
+  set(FLIPSCOPE_ZSTD zstd::libzstd_shared)
+else()
+  set(FLIPSCOPE_ZSTD zstd::libzstd_static)
+endif()

@@ -1,0 +1,65 @@
+// Error reporting in three tiers (see STYLE.md):
+//  - InputError / FileError: bad user input or a bad file; the message names the file, the
+//    offset or field, and what was expected. Tools print it and exit with kExitBadInput.
+//  - FLIPSCOPE_CHECK: programmer errors; always on, throws LogicError with both values.
+//  - Recoverable oddities (NaN positions, particles outside the domain) are counted by the
+//    code that meets them and reported, never thrown.
+#pragma once
+
+#include <filesystem>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+namespace flipscope {
+
+/// Exit codes of the flipscope command.
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitFailure = 1;   ///< verification failed, or an internal error
+inline constexpr int kExitUsage = 2;     ///< bad command line
+inline constexpr int kExitBadInput = 3;  ///< unreadable, truncated or corrupted input file
+
+/// Bad input from the user (command line values, inconsistent options).
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// A file that cannot be read or written, or whose content is malformed.
+/// what() reads "<path>: <reason>".
+class FileError : public InputError {
+ public:
+  FileError(const std::filesystem::path& path, const std::string& reason)
+      : InputError(path.string() + ": " + reason), mPath(path) {}
+  const std::filesystem::path& path() const { return mPath; }
+
+ private:
+  std::filesystem::path mPath;
+};
+
+/// A violated internal invariant.
+class LogicError : public std::logic_error {
+ public:
+  using std::logic_error::logic_error;
+};
+
+namespace detail {
+[[noreturn]] inline void checkFailed(const char* expr, const char* file, int line, const std::string& msg) {
+  std::ostringstream os;
+  os << file << ":" << line << ": check failed: " << expr;
+  if (!msg.empty()) os << " (" << msg << ")";
+  throw LogicError(os.str());
+}
+}  // namespace detail
+
+}  // namespace flipscope
+
+/// Always-on invariant check: FLIPSCOPE_CHECK(a == b, "a=" << a << " b=" << b).
+#define FLIPSCOPE_CHECK(cond, ...)                                                         \
+  do {                                                                                      \
+    if (!(cond)) {                                                                          \
+      std::ostringstream flipscope_check_os_;                                               \
+      flipscope_check_os_ << "" __VA_ARGS__;                                                \
+      ::flipscope::detail::checkFailed(#cond, __FILE__, __LINE__, flipscope_check_os_.str()); \
+    }                                                                                       \
+  } while (0)

@@ -1,0 +1,62 @@
+// ParticleSource: a stream of particles read in chunks, so that files larger than memory
+// convert with bounded memory. Readers for each format implement it (VdbPointsReader,
+// PlyReader, RawReader), and so does the synthetic generator (SynthFluid).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+namespace flipscope {
+
+/// One chunk of particles in world units. `velocities` is empty when the source has none,
+/// otherwise it has the size of `positions`.
+struct ParticleChunk {
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> velocities;
+  void clear() {
+    positions.clear();
+    velocities.clear();
+  }
+  std::size_t size() const { return positions.size(); }
+};
+
+class ParticleSource {
+ public:
+  virtual ~ParticleSource() = default;
+  /// What error messages call this source (usually the file path).
+  virtual std::string name() const = 0;
+  /// Whether chunks carry velocities (and want them: see ReadOptions::velocity).
+  virtual bool hasVelocity() const = 0;
+  /// Total particle count when known without reading the data (file headers), else nullopt.
+  virtual std::optional<std::uint64_t> countHint() const = 0;
+  /// Replaces `chunk` with the next at most `maxParticles` particles (maxParticles > 0).
+  /// Returns false, with `chunk` empty, at the end. Throws FileError on malformed data.
+  /// Values are passed on as stored: NaN/Inf are the caller's to count and skip.
+  virtual bool read(ParticleChunk& chunk, std::size_t maxParticles) = 0;
+  /// Starts over from the first particle (multi-pass conversion: bounds, then binning).
+  virtual void rewind() = 0;
+};
+
+struct ReadOptions {
+  /// VDB: names of the PointDataGrids to read; empty = every PointDataGrid in the file.
+  std::vector<std::string> grids;
+  /// Read velocities when the file has them (`v` in VDB, `vx vy vz` in PLY).
+  bool velocity = true;
+};
+
+/// Opens a particle file by its extension: .vdb, .ply, .bin/.raw (little-endian float32 xyz).
+/// Throws FileError for unknown extensions, missing files and bad headers.
+std::unique_ptr<ParticleSource> openParticleFile(const std::filesystem::path& path, const ReadOptions& options = {});
+
+/// Reads several sources one after the other as one (e.g. the FLIP and the spray file of one
+/// frame). hasVelocity() is true only if every part has velocities.
+std::unique_ptr<ParticleSource> concatSources(std::vector<std::unique_ptr<ParticleSource>> parts);
+
+}  // namespace flipscope

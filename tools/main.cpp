@@ -1,0 +1,38 @@
+// flipscope: previewer for giga-particle fluid caches. See README.md.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+
+#include "core/Error.h"
+#include "tools/Commands.h"
+
+int main(int argc, char** argv) {
+  using namespace flipscope;
+  CLI::App app{"flipscope: preview giga-particle fluid simulation caches (Reichl et al. 2014)", "flipscope"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "flipscope 0.1.0");
+  tools::addConvertCommand(app);
+  tools::addInfoCommand(app);
+  tools::addSynthCommand(app);
+  tools::addBenchCommand(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    int code = app.exit(e);
+    return code == 0 ? kExitOk : kExitUsage;
+  } catch (const FileError& e) {
+    std::fprintf(stderr, "flipscope: error: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "flipscope: error: %s\n", e.what());
+    return kExitUsage;
+  } catch (const tools::CommandFailed& e) {
+    std::fprintf(stderr, "flipscope: %s\n", e.what());
+    return kExitFailure;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "flipscope: internal error: %s\n", e.what());
+    return kExitFailure;
+  }
+  return kExitOk;
+}
