@@ -1,13 +1,15 @@
 #include <CLI/CLI.hpp>
 
-#include "core/Error.h"
 #include "tools/Commands.h"
 
 namespace flipscope::tools {
 
 void addBenchCommand(CLI::App& app) {
-  auto* cmd = app.add_subcommand("bench", "(not yet implemented)");
-  cmd->callback([] { throw InputError("bench: not yet implemented"); });
+  auto* bench = app.add_subcommand("bench", "Benchmarks, printed as tables with the comparison in the same run");
+  bench->require_subcommand(1);
+  addBenchPreprocessCommand(*bench);
+  addBenchStreamingCommand(*bench);
+  addBenchRenderCommand(*bench);
 }
 
 }  // namespace flipscope::tools

@@ -21,6 +21,13 @@ class CommandFailed : public std::runtime_error {
 void addConvertCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);
 void addSynthCommand(CLI::App& app);
-void addBenchCommand(CLI::App& app);
+void addBenchCommand(CLI::App& app);  // creates `bench` and calls the three below
+void addRenderCommand(CLI::App& app);
+void addDemoCommand(CLI::App& app);
+
+// `flipscope bench <stage>`: each in its own file (tools/Bench<Stage>.cpp).
+void addBenchPreprocessCommand(CLI::App& bench);
+void addBenchStreamingCommand(CLI::App& bench);
+void addBenchRenderCommand(CLI::App& bench);
 
 }  // namespace flipscope::tools

@@ -16,6 +16,8 @@ int main(int argc, char** argv) {
   tools::addInfoCommand(app);
   tools::addSynthCommand(app);
   tools::addBenchCommand(app);
+  tools::addRenderCommand(app);
+  tools::addDemoCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
