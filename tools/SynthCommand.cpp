@@ -107,12 +107,11 @@ void runSynth(const SynthArguments& args) {
   progress.finish();
 
   const Box domain = first.domain();
-  std::printf("synth: wrote %llu frame%s (%d-%d) to %s: %s particles a frame (%llu), %s in total, %sB\n",
-              static_cast<unsigned long long>(frameCount), frameCount > 1 ? "s" : "", frames.first, frames.last,
-              args.output.c_str(), Progress::humanCount(double(first.count())).c_str(),
-              static_cast<unsigned long long>(first.count()),
-              Progress::humanCount(double(first.count() * frameCount)).c_str(),
-              Progress::humanCount(double(bytes)).c_str());
+  std::string frameText = sequence ? "frames " + args.frames : "frame " + std::to_string(frames.first);
+  std::printf(
+      "synth: wrote %s to %s: %s particles a frame (%llu), %s in total, %sB\n", frameText.c_str(), args.output.c_str(),
+      Progress::humanCount(double(first.count())).c_str(), static_cast<unsigned long long>(first.count()),
+      Progress::humanCount(double(first.count() * frameCount)).c_str(), Progress::humanCount(double(bytes)).c_str());
   std::printf("synth: domain [0, 0, 0] - [%.6g, %.6g, %.6g] m, %.6g s a frame\n", domain.max.x, domain.max.y,
               domain.max.z, first.frameTime());
   std::printf("synth: 8 particles per cell in the body at: flipscope convert --cell-size %.9g\n", first.cellSize());
