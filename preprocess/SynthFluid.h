@@ -18,7 +18,6 @@
 #include <string>
 #include <vector>
 
-#include <glm/common.hpp>  // core/Box.h uses glm::min/max without including it
 #include <glm/vec3.hpp>
 
 #include "core/Box.h"

@@ -3,7 +3,6 @@
 #include <CLI/CLI.hpp>
 
 #include <cctype>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -17,6 +16,7 @@
 #include "preprocess/InputSequence.h"
 #include "preprocess/ParticleWriter.h"
 #include "preprocess/SynthFluid.h"
+#include "tools/CliValues.h"
 #include "tools/Commands.h"
 
 namespace flipscope::tools {
@@ -28,21 +28,12 @@ constexpr std::uint64_t kMaxParticles = 1'000'000'000;
 constexpr std::uint64_t kMaxVdbParticles = 50'000'000;  // the VDB writer holds a frame in memory
 constexpr std::size_t kChunkParticles = 1 << 20;
 
-/// "250k", "1.5M", "1G", "20000": k = 1e3, M = 1e6, G = 1e9; 1 k to 1 G.
+/// --particles: a count from 1 k to 1 G (suffixes k, M, G).
 std::uint64_t parseParticleCount(const std::string& text) {
-  auto fail = [&] {
-    return InputError("--particles: expected a count from 1k to 1G (suffixes k, M, G), got '" + text + "'");
-  };
-  double value = 0;
-  auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (error != std::errc() || !(value > 0)) throw fail();
-  std::string suffix(end, text.data() + text.size());
-  static const std::map<std::string, double> kScale = {{"", 1}, {"k", 1e3}, {"K", 1e3}, {"M", 1e6}, {"G", 1e9}};
-  auto scale = kScale.find(suffix);
-  if (scale == kScale.end()) throw fail();
-  double count = std::round(value * scale->second);
-  if (count < double(kMinParticles) || count > double(kMaxParticles)) throw fail();
-  return std::uint64_t(count);
+  std::uint64_t count = parseCount("--particles", text);
+  if (count < kMinParticles || count > kMaxParticles)
+    throw InputError("--particles: expected a count from 1k to 1G, got '" + text + "'");
+  return count;
 }
 
 struct SynthArguments {

@@ -77,8 +77,8 @@ TEST_F(SynthCommand, BadArgumentsFailWithAMessage) {
   };
   for (const Case& c :
        {Case{"-o f.bin --particles 2G", "1k to 1G"}, Case{"-o f.bin --particles 999", "1k to 1G"},
-        Case{"-o f.bin --particles 12x", "1k to 1G"}, Case{"-o f.bin --particles 1k --frames 0-4", "frame pattern"},
-        Case{"-o f.vdb --particles 60M", "VDB"}}) {
+        Case{"-o f.bin --particles 12x", "--particles: cannot read"},
+        Case{"-o f.bin --particles 1k --frames 0-4", "frame pattern"}, Case{"-o f.vdb --particles 60M", "VDB"}}) {
     CommandRun run = synth(mDir, c.arguments);
     EXPECT_EQ(run.exitCode, 2) << c.arguments << ": " << run.output;
     EXPECT_NE(run.output.find(c.message), std::string::npos) << c.arguments << ": " << run.output;
