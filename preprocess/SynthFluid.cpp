@@ -263,7 +263,7 @@ void SynthFluid::particle(std::uint64_t index, glm::vec3& position, glm::vec3* v
 }
 
 bool SynthFluid::read(ParticleChunk& chunk, std::size_t maxParticles) {
-  FLIPSCOPE_CHECK(maxParticles > 0);
+  FLIPSCOPE_CHECK(maxParticles > 0, "maxParticles=" << maxParticles);
   std::uint64_t n = std::min<std::uint64_t>(maxParticles, count() - mNext);
   chunk.positions.resize(n);
   chunk.velocities.resize(mOptions.velocity ? n : 0);
