@@ -59,7 +59,7 @@ namespace detail {
   do {                                                                                      \
     if (!(cond)) {                                                                          \
       std::ostringstream flipscope_check_os_;                                               \
-      flipscope_check_os_ << "" __VA_ARGS__;                                                \
+      flipscope_check_os_ __VA_OPT__(<< __VA_ARGS__);                                      \
       ::flipscope::detail::checkFailed(#cond, __FILE__, __LINE__, flipscope_check_os_.str()); \
     }                                                                                       \
   } while (0)

@@ -1,0 +1,97 @@
+// Brick payload codec. A payload is one zstd frame of:
+//   varint occupied                      number of occupied cells
+//   varint gap[occupied]                 cells[0], then cells[i] - cells[i-1] - 1
+//   varint countMinus1[occupied]         particles per cell, minus one
+//   u16    attribute[particles]          only if the store has an attribute
+// Separate streams compress far better than interleaved ones: at 8 particles per cell most
+// gaps and counts are tiny and repeat. Particles are quantized to their cell (Reichl et al.
+// 2014 §3, §4.3), so cells and counts are all that is left of the positions.
+#include <zstd.h>
+
+#include <algorithm>
+
+#include "core/Bytes.h"
+#include "preprocess/BrickStore.h"
+
+namespace flipscope {
+
+std::uint64_t DecodedBrick::particleCount() const {
+  std::uint64_t n = 0;
+  for (auto c : counts) n += c;
+  return n;
+}
+
+std::vector<std::byte> encodeBrick(const DecodedBrick& brick, int zstdLevel) {
+  FLIPSCOPE_CHECK(brick.cells.size() == brick.counts.size(), brick.cells.size() << " vs " << brick.counts.size());
+  ByteWriter raw;
+  raw.bytes().reserve(brick.cells.size() * 2 + brick.attributes.size() * 2 + 8);
+  raw.putVarint(brick.cells.size());
+  std::uint32_t previous = 0;
+  for (std::size_t i = 0; i < brick.cells.size(); ++i) {
+    FLIPSCOPE_CHECK(i == 0 || brick.cells[i] > previous, "cells not ascending");
+    raw.putVarint(i == 0 ? brick.cells[i] : brick.cells[i] - previous - 1);
+    previous = brick.cells[i];
+  }
+  for (auto c : brick.counts) {
+    FLIPSCOPE_CHECK(c >= 1, "empty cell in brick");
+    raw.putVarint(c - 1);
+  }
+  raw.putArray(std::span<const std::uint16_t>(brick.attributes));
+
+  std::vector<std::byte> out(ZSTD_compressBound(raw.size()));
+  thread_local ZSTD_CCtx* context = ZSTD_createCCtx();
+  std::size_t n = ZSTD_compressCCtx(context, out.data(), out.size(), raw.view().data(), raw.size(), zstdLevel);
+  FLIPSCOPE_CHECK(!ZSTD_isError(n), ZSTD_getErrorName(n));
+  out.resize(n);
+  return out;
+}
+
+DecodedBrick decodeBrick(std::span<const std::byte> payload, const std::filesystem::path& file, std::uint32_t brickIndex,
+                         const BrickRecord& expected, std::uint32_t cellsPerBrick, bool hasAttribute) {
+  const std::string where = "brick " + std::to_string(brickIndex);
+  auto fail = [&](const std::string& reason) -> FileError { return FileError(file, where + ": " + reason); };
+
+  // Largest valid raw size: a 5-byte varint per gap and count, plus the attributes.
+  const std::uint64_t bound = 10 + 10ull * expected.cells + (hasAttribute ? 2ull * expected.particles : 0);
+  const unsigned long long declared = ZSTD_getFrameContentSize(payload.data(), payload.size());
+  if (declared == ZSTD_CONTENTSIZE_ERROR || declared == ZSTD_CONTENTSIZE_UNKNOWN)
+    throw fail("payload is not a zstd frame of known size");
+  if (declared > bound) throw fail("payload declares " + std::to_string(declared) + " bytes, more than possible");
+  std::vector<std::byte> raw(declared);
+  thread_local ZSTD_DCtx* context = ZSTD_createDCtx();
+  std::size_t n = ZSTD_decompressDCtx(context, raw.data(), raw.size(), payload.data(), payload.size());
+  if (ZSTD_isError(n)) throw fail(std::string("zstd: ") + ZSTD_getErrorName(n));
+  if (n != declared) throw fail("payload decompressed to fewer bytes than declared");
+
+  ByteReader in(raw, file.string() + ", " + where + " (decompressed)");
+  DecodedBrick brick;
+  const std::uint64_t occupied = in.getVarint("occupied cells");
+  if (occupied != expected.cells)
+    throw fail("holds " + std::to_string(occupied) + " cells, table says " + std::to_string(expected.cells));
+  brick.cells.resize(occupied);
+  brick.counts.resize(occupied);
+  std::uint64_t cell = 0;
+  for (std::uint64_t i = 0; i < occupied; ++i) {
+    std::uint64_t gap = in.getVarint("cell gap");
+    cell = i == 0 ? gap : cell + 1 + gap;
+    if (cell >= cellsPerBrick) throw fail("cell index " + std::to_string(cell) + " outside the brick");
+    brick.cells[i] = std::uint32_t(cell);
+  }
+  std::uint64_t particles = 0;
+  for (std::uint64_t i = 0; i < occupied; ++i) {
+    std::uint64_t count = in.getVarint("cell count") + 1;
+    if (count > expected.particles) throw fail("cell count larger than the brick's particle count");
+    brick.counts[i] = std::uint32_t(count);
+    particles += count;
+  }
+  if (particles != expected.particles)
+    throw fail("holds " + std::to_string(particles) + " particles, table says " + std::to_string(expected.particles));
+  if (hasAttribute) {
+    brick.attributes.resize(particles);
+    in.getArray(std::span<std::uint16_t>(brick.attributes), "attributes");
+  }
+  in.expectEnd("end of brick payload");
+  return brick;
+}
+
+}  // namespace flipscope

@@ -1,0 +1,403 @@
+// BrickStore: store header, frame files and brick reads (format in BrickStore.h, FrameFile.h).
+#include "preprocess/BrickStore.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <mutex>
+#include <set>
+
+#include "core/Bytes.h"
+#include "core/Hash.h"
+#include "core/Morton.h"
+#include "preprocess/FrameFile.h"
+
+namespace flipscope {
+namespace {
+
+constexpr char kStoreMagic[8] = {'F', 'S', 'S', 'T', 'O', 'R', 'E', '1'};
+constexpr std::size_t kStoreHeaderBytes = 8 + 4 + 4 + 8 + 24 + 12 + 4 + 8;
+
+bool isValidBrickSize(std::uint32_t b) { return b == 32 || b == 64 || b == 128; }
+
+std::string frameFileName(int frame) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%06d.fsf", frame);
+  return name;
+}
+
+std::optional<int> frameFromFileName(const std::string& name) {
+  if (name.size() != 16 || name.rfind("frame_", 0) != 0 || name.substr(12) != ".fsf") return std::nullopt;
+  int frame = 0;
+  for (char c : name.substr(6, 6)) {
+    if (c < '0' || c > '9') return std::nullopt;
+    frame = frame * 10 + (c - '0');
+  }
+  return frame;
+}
+
+/// pread exactly `n` bytes at `offset`; FileError naming `what` when the file is shorter.
+void readAt(int fd, const std::filesystem::path& file, std::uint64_t offset, void* out, std::size_t n, const char* what) {
+  auto p = static_cast<char*>(out);
+  while (n > 0) {
+    ssize_t got = ::pread(fd, p, n, off_t(offset));
+    if (got < 0 && errno == EINTR) continue;
+    if (got < 0) throw FileError(file, std::string("read failed (") + what + "): " + std::strerror(errno));
+    if (got == 0) throw FileError(file, std::string("truncated: ") + what + " ends past the end of the file");
+    p += got;
+    offset += std::uint64_t(got);
+    n -= std::size_t(got);
+  }
+}
+
+class FileHandle {
+ public:
+  explicit FileHandle(const std::filesystem::path& file) : mFd(::open(file.c_str(), O_RDONLY | O_CLOEXEC)) {
+    if (mFd < 0) throw FileError(file, std::string("cannot open: ") + std::strerror(errno));
+  }
+  ~FileHandle() { ::close(mFd); }
+  FileHandle(const FileHandle&) = delete;
+  FileHandle& operator=(const FileHandle&) = delete;
+  int fd() const { return mFd; }
+
+ private:
+  int mFd;
+};
+
+void serializeFooter(ByteWriter& w, const FrameFooter& f) {
+  w.put(f.octreeOffset);
+  w.put(f.octreeLevels);
+  w.put(f.nodeCount);
+  w.put(f.tableOffset);
+  w.put(f.brickCount);
+  w.put(f.frame);
+  w.put(f.stats.particles);
+  w.put(f.stats.skippedInvalid);
+  w.put(f.stats.skippedOutside);
+  w.put(f.stats.attributeMin);
+  w.put(f.stats.attributeMax);
+  w.put(f.version);
+  w.put(f.reserved);
+}
+
+FrameFooter parseFooter(ByteReader& r) {
+  FrameFooter f;
+  f.octreeOffset = r.get<std::uint64_t>("footer octree offset");
+  f.octreeLevels = r.get<std::uint32_t>("footer octree levels");
+  f.nodeCount = r.get<std::uint32_t>("footer node count");
+  f.tableOffset = r.get<std::uint64_t>("footer table offset");
+  f.brickCount = r.get<std::uint32_t>("footer brick count");
+  f.frame = r.get<std::int32_t>("footer frame");
+  f.stats.particles = r.get<std::uint64_t>("footer particles");
+  f.stats.skippedInvalid = r.get<std::uint64_t>("footer skipped invalid");
+  f.stats.skippedOutside = r.get<std::uint64_t>("footer skipped outside");
+  f.stats.attributeMin = r.get<float>("footer attribute min");
+  f.stats.attributeMax = r.get<float>("footer attribute max");
+  f.version = r.get<std::uint32_t>("footer version");
+  f.reserved = r.get<std::uint32_t>("footer reserved");
+  f.indexChecksum = r.get<std::uint64_t>("footer checksum");
+  return f;
+}
+
+void serializeRecord(ByteWriter& w, const BrickRecord& b) {
+  w.put(b.coord.x);
+  w.put(b.coord.y);
+  w.put(b.coord.z);
+  w.put(b.particles);
+  w.put(b.cells);
+  w.put(b.bytes);
+  w.put(b.offset);
+  w.put(b.checksum);
+}
+
+}  // namespace
+
+const char* attributeName(AttributeKind kind) {
+  switch (kind) {
+    case AttributeKind::None: return "none";
+    case AttributeKind::Speed: return "speed";
+  }
+  return "unknown";
+}
+
+// ---- store header ----------------------------------------------------------------------
+
+std::vector<std::byte> serializeStoreHeader(const StoreHeader& h) {
+  ByteWriter w;
+  w.append(kStoreMagic, sizeof kStoreMagic);
+  w.put(h.version);
+  w.put(h.brickSize);
+  w.put(h.cellSize);
+  w.put(h.origin.x);
+  w.put(h.origin.y);
+  w.put(h.origin.z);
+  w.put(h.brickGrid.x);
+  w.put(h.brickGrid.y);
+  w.put(h.brickGrid.z);
+  w.put(static_cast<std::uint32_t>(h.attribute));
+  w.put(checksum64(w.view()));
+  FLIPSCOPE_CHECK(w.size() == kStoreHeaderBytes, w.size());
+  return std::move(w.bytes());
+}
+
+StoreHeader parseStoreHeader(std::span<const std::byte> bytes, const std::filesystem::path& file) {
+  ByteReader r(bytes, file);
+  auto magic = r.getBytes(8, "magic");
+  if (std::memcmp(magic.data(), kStoreMagic, 8) != 0) r.fail("magic", "not a flipscope store header");
+  StoreHeader h;
+  h.version = r.get<std::uint32_t>("version");
+  if (h.version != kStoreVersion)
+    r.fail("version", "unsupported store version " + std::to_string(h.version) + " (this flipscope reads version " +
+                          std::to_string(kStoreVersion) + ")");
+  h.brickSize = r.get<std::uint32_t>("brick size");
+  h.cellSize = r.get<double>("cell size");
+  h.origin.x = r.get<double>("origin x");
+  h.origin.y = r.get<double>("origin y");
+  h.origin.z = r.get<double>("origin z");
+  h.brickGrid.x = r.get<std::uint32_t>("brick grid x");
+  h.brickGrid.y = r.get<std::uint32_t>("brick grid y");
+  h.brickGrid.z = r.get<std::uint32_t>("brick grid z");
+  auto attribute = r.get<std::uint32_t>("attribute");
+  const std::size_t checked = r.position();
+  auto stored = r.get<std::uint64_t>("checksum");
+  r.expectEnd("end of store header");
+  if (stored != checksum64(bytes.first(checked))) throw FileError(file, "header checksum mismatch (file corrupted)");
+  if (!isValidBrickSize(h.brickSize)) throw FileError(file, "invalid brick size " + std::to_string(h.brickSize));
+  if (!(std::isfinite(h.cellSize) && h.cellSize > 0)) throw FileError(file, "invalid cell size");
+  if (!std::isfinite(h.origin.x) || !std::isfinite(h.origin.y) || !std::isfinite(h.origin.z))
+    throw FileError(file, "invalid origin");
+  for (int a = 0; a < 3; ++a)
+    if (h.brickGrid[a] == 0 || std::uint64_t(h.brickGrid[a]) * h.brickSize > 65536)
+      throw FileError(file, "invalid brick grid");
+  if (attribute > 1) throw FileError(file, "unknown attribute kind " + std::to_string(attribute));
+  h.attribute = AttributeKind(attribute);
+  return h;
+}
+
+// ---- frame files -------------------------------------------------------------------------
+
+FrameWriter::FrameWriter(const std::filesystem::path& file, const StoreHeader& header, int frame)
+    : mHeader(header), mFrame(frame), mFile(file) {
+  mFile.write(kFrameMagic, sizeof kFrameMagic);
+}
+
+void FrameWriter::addBrick(glm::uvec3 coord, std::uint32_t particles, std::uint32_t cells,
+                           std::span<const std::byte> payload) {
+  const std::uint32_t code = mortonEncode3(coord.x, coord.y, coord.z);
+  FLIPSCOPE_CHECK(mCodes.empty() || code > mCodes.back(), "bricks out of Morton order");
+  BrickRecord r;
+  r.coord = coord;
+  r.particles = particles;
+  r.cells = cells;
+  r.bytes = std::uint32_t(payload.size());
+  r.offset = mFile.offset();
+  r.checksum = checksum64(payload);
+  mFile.write(payload);
+  mRecords.push_back(r);
+  mCodes.push_back(code);
+}
+
+FrameIndex FrameWriter::finish(const FrameStats& stats) {
+  const std::uint32_t maxBricks = std::max({mHeader.brickGrid.x, mHeader.brickGrid.y, mHeader.brickGrid.z});
+  FrameIndex index;
+  index.frame = mFrame;
+  index.file = mFile.destination();
+  index.stats = stats;
+  index.octree = PresenceOctree::build(mCodes, maxBricks);
+  index.bricks = std::move(mRecords);
+
+  FrameFooter footer;
+  footer.octreeLevels = index.octree.levels;
+  footer.nodeCount = std::uint32_t(index.octree.nodes.size());
+  footer.brickCount = std::uint32_t(index.bricks.size());
+  footer.frame = mFrame;
+  footer.stats = stats;
+  footer.octreeOffset = mFile.offset();
+  footer.tableOffset = footer.octreeOffset + 8ull * footer.nodeCount;
+  ByteWriter w;
+  w.putArray(std::span<const OctreeNode>(index.octree.nodes));
+  for (const auto& r : index.bricks) serializeRecord(w, r);
+  serializeFooter(w, footer);
+  w.put(checksum64(w.view()));
+  w.append(kFooterMagic, sizeof kFooterMagic);
+  mFile.write(w.view());
+  index.fileBytes = mFile.offset();
+  mFile.commit();
+  return index;
+}
+
+FrameIndex readFrameIndex(const std::filesystem::path& file, const StoreHeader& header) {
+  FileHandle handle(file);
+  std::error_code ec;
+  const std::uint64_t size = std::filesystem::file_size(file, ec);
+  if (ec) throw FileError(file, "cannot stat: " + ec.message());
+  if (size < sizeof kFrameMagic + kFrameFooterBytes)
+    throw FileError(file, "truncated: " + std::to_string(size) + " bytes, smaller than an empty frame");
+  char magic[8];
+  readAt(handle.fd(), file, 0, magic, 8, "frame magic");
+  if (std::memcmp(magic, kFrameMagic, 8) != 0) throw FileError(file, "at byte 0 (magic): not a flipscope frame file");
+
+  std::vector<std::byte> footerBytes(kFrameFooterBytes);
+  const std::uint64_t footerOffset = size - kFrameFooterBytes;
+  readAt(handle.fd(), file, footerOffset, footerBytes.data(), footerBytes.size(), "footer");
+  if (std::memcmp(footerBytes.data() + kFrameFooterBytes - 8, kFooterMagic, 8) != 0)
+    throw FileError(file, "no frame footer at byte " + std::to_string(footerOffset) +
+                              " (file truncated or corrupted)");
+  ByteReader fr(std::span<const std::byte>(footerBytes).first(kFrameFooterBytes - 8), file, footerOffset);
+  FrameFooter footer = parseFooter(fr);
+  if (footer.version != kStoreVersion)
+    throw FileError(file, "unsupported frame version " + std::to_string(footer.version));
+  // The index region runs from the octree to the checksum field; check sizes before reading.
+  const std::uint64_t nodesBytes = 8ull * footer.nodeCount;
+  const std::uint64_t tableBytes = 40ull * footer.brickCount;
+  if (footer.octreeOffset < sizeof kFrameMagic || footer.tableOffset != footer.octreeOffset + nodesBytes ||
+      footer.tableOffset + tableBytes != footerOffset)
+    throw FileError(file, "footer offsets inconsistent with the file size (file truncated or corrupted)");
+  std::vector<std::byte> index(nodesBytes + tableBytes + kFrameFooterBytes - 16);
+  readAt(handle.fd(), file, footer.octreeOffset, index.data(), index.size(), "octree and brick table");
+  if (checksum64(index) != footer.indexChecksum)
+    throw FileError(file, "index checksum mismatch: octree, brick table or footer corrupted");
+
+  FrameIndex out;
+  out.file = file;
+  out.fileBytes = size;
+  out.frame = footer.frame;
+  out.stats = footer.stats;
+  out.octree.levels = footer.octreeLevels;
+  out.octree.nodes.resize(footer.nodeCount);
+  ByteReader r(std::span<const std::byte>(index).first(nodesBytes + tableBytes), file, footer.octreeOffset);
+  r.getArray(std::span(out.octree.nodes), "octree");
+  out.bricks.resize(footer.brickCount);
+  std::vector<std::uint32_t> codes;
+  codes.reserve(footer.brickCount);
+  std::uint64_t expectedOffset = sizeof kFrameMagic, particles = 0;
+  for (std::uint32_t i = 0; i < footer.brickCount; ++i) {
+    BrickRecord& b = out.bricks[i];
+    b.coord.x = r.get<std::uint32_t>("brick x");
+    b.coord.y = r.get<std::uint32_t>("brick y");
+    b.coord.z = r.get<std::uint32_t>("brick z");
+    b.particles = r.get<std::uint32_t>("brick particles");
+    b.cells = r.get<std::uint32_t>("brick cells");
+    b.bytes = r.get<std::uint32_t>("brick bytes");
+    b.offset = r.get<std::uint64_t>("brick offset");
+    b.checksum = r.get<std::uint64_t>("brick checksum");
+    const std::string which = "brick " + std::to_string(i);
+    if (b.coord.x >= header.brickGrid.x || b.coord.y >= header.brickGrid.y || b.coord.z >= header.brickGrid.z)
+      throw FileError(file, which + ": coordinates outside the brick grid");
+    if (b.offset != expectedOffset || b.bytes == 0)
+      throw FileError(file, which + ": payload range does not follow the previous brick");
+    if (b.cells == 0 || b.cells > header.cellsPerBrick() || b.particles < b.cells)
+      throw FileError(file, which + ": invalid particle or cell count");
+    expectedOffset += b.bytes;
+    particles += b.particles;
+    const std::uint32_t code = mortonEncode3(b.coord.x, b.coord.y, b.coord.z);
+    if (!codes.empty() && code <= codes.back()) throw FileError(file, which + ": bricks out of Morton order");
+    codes.push_back(code);
+  }
+  if (expectedOffset != footer.octreeOffset) throw FileError(file, "brick payloads do not end where the octree starts");
+  if (particles != footer.stats.particles) throw FileError(file, "brick particle counts do not add up to the total");
+  const std::uint32_t maxBricks = std::max({header.brickGrid.x, header.brickGrid.y, header.brickGrid.z});
+  if (footer.octreeLevels != octreeLevelsFor(maxBricks) ||
+      PresenceOctree::build(codes, maxBricks).nodes != out.octree.nodes)
+    throw FileError(file, "presence octree does not match the brick table");
+  return out;
+}
+
+// ---- BrickStore --------------------------------------------------------------------------
+
+struct BrickStore::Shared {
+  std::mutex mutex;
+  std::set<int> frames;
+  std::map<int, std::shared_ptr<const FrameIndex>> indices;
+};
+
+bool BrickStore::exists(const std::filesystem::path& dir) {
+  std::error_code ec;
+  return std::filesystem::exists(dir / kStoreHeaderName, ec);
+}
+
+BrickStore BrickStore::open(const std::filesystem::path& dir) {
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) throw FileError(dir, "not a brick store directory");
+  const auto headerPath = dir / kStoreHeaderName;
+  if (!std::filesystem::exists(headerPath, ec))
+    throw FileError(dir, std::string("not a brick store: ") + kStoreHeaderName + " missing");
+  BrickStore store;
+  store.mDir = dir;
+  store.mHeader = parseStoreHeader(readFile(headerPath), headerPath);
+  store.mShared = std::make_shared<Shared>();
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (auto frame = frameFromFileName(entry.path().filename().string())) store.mShared->frames.insert(*frame);
+  }
+  return store;
+}
+
+BrickStore BrickStore::createOrAppend(const std::filesystem::path& dir, const StoreHeader& header) {
+  if (exists(dir)) {
+    BrickStore store = open(dir);
+    const StoreHeader& h = store.header();
+    if (h.brickSize != header.brickSize || h.cellSize != header.cellSize || h.origin != header.origin ||
+        h.brickGrid != header.brickGrid || h.attribute != header.attribute)
+      throw FileError(dir, "existing store has a different domain, cell size, brick size or attribute");
+    return store;
+  }
+  std::filesystem::create_directories(dir);
+  writeFileAtomically(dir / kStoreHeaderName, serializeStoreHeader(header));
+  return open(dir);
+}
+
+std::vector<int> BrickStore::frames() const {
+  std::lock_guard lock(mShared->mutex);
+  return {mShared->frames.begin(), mShared->frames.end()};
+}
+
+bool BrickStore::hasFrame(int frame) const {
+  std::lock_guard lock(mShared->mutex);
+  return mShared->frames.count(frame) != 0;
+}
+
+std::filesystem::path BrickStore::framePath(int frame) const { return mDir / frameFileName(frame); }
+
+void BrickStore::addFrame(int frame) {
+  std::lock_guard lock(mShared->mutex);
+  mShared->frames.insert(frame);
+  mShared->indices.erase(frame);
+}
+
+std::shared_ptr<const FrameIndex> BrickStore::frame(int frame) const {
+  {
+    std::lock_guard lock(mShared->mutex);
+    if (!mShared->frames.count(frame))
+      throw InputError(mDir.string() + ": no frame " + std::to_string(frame) + " in the store");
+    if (auto it = mShared->indices.find(frame); it != mShared->indices.end()) return it->second;
+  }
+  auto index = std::make_shared<const FrameIndex>(readFrameIndex(framePath(frame), mHeader));
+  if (index->frame != frame) throw FileError(framePath(frame), "footer names frame " + std::to_string(index->frame));
+  std::lock_guard lock(mShared->mutex);
+  return mShared->indices.emplace(frame, index).first->second;
+}
+
+std::vector<std::byte> BrickStore::readPayload(const FrameIndex& frame, std::uint32_t brickIndex) const {
+  FLIPSCOPE_CHECK(brickIndex < frame.bricks.size(), brickIndex << " of " << frame.bricks.size());
+  const BrickRecord& b = frame.bricks[brickIndex];
+  std::vector<std::byte> payload(b.bytes);
+  FileHandle handle(frame.file);
+  readAt(handle.fd(), frame.file, b.offset, payload.data(), payload.size(), "brick payload");
+  if (checksum64(payload) != b.checksum)
+    throw FileError(frame.file, "brick " + std::to_string(brickIndex) + " at (" + std::to_string(b.coord.x) + "," +
+                                    std::to_string(b.coord.y) + "," + std::to_string(b.coord.z) +
+                                    "): checksum mismatch (payload corrupted)");
+  return payload;
+}
+
+DecodedBrick BrickStore::readBrick(const FrameIndex& frame, std::uint32_t brickIndex) const {
+  auto payload = readPayload(frame, brickIndex);
+  return decodeBrick(payload, frame.file, brickIndex, frame.bricks[brickIndex], mHeader.cellsPerBrick(),
+                     mHeader.attribute != AttributeKind::None);
+}
+
+}  // namespace flipscope
