@@ -1,0 +1,221 @@
+// Brick conversion into bit-bricks (Reichl et al. 2014 §3.1: "the conversion process works
+// solely on 3D arrays of integers, using bit operations and address arithmetic"), the overlap
+// border of §3.3.1 and the attribute storage of §3.2.
+#include "streaming/BitBrick.h"
+
+#include <bit>
+#include <string>
+
+#include "core/Error.h"
+
+namespace flipscope {
+namespace {
+
+static_assert(sizeof(glm::uvec4) == 16, "sub-bricks are addressed as 4 consecutive words");
+
+bool isBrickSize(std::uint32_t size) { return size == 32 || size == 64 || size == 128; }
+
+// Bits [pos, pos + count) of a bitset, count <= 64; the bitset has a padding word at its end.
+std::uint64_t extractBits(const std::uint64_t* words, std::uint64_t pos, std::uint32_t count) {
+  std::uint64_t word = pos >> 6;
+  std::uint32_t shift = pos & 63;
+  std::uint64_t value = words[word] >> shift;
+  if (shift != 0 && shift + count > 64) value |= words[word + 1] << (64 - shift);
+  return count < 64 ? value & ((std::uint64_t(1) << count) - 1) : value;
+}
+
+void insertBits(std::uint64_t* row, std::uint32_t pos, std::uint64_t value, std::uint32_t count) {
+  std::uint32_t shift = pos & 63;
+  row[pos >> 6] |= value << shift;
+  if (shift != 0 && shift + count > 64) row[(pos >> 6) + 1] |= value >> (64 - shift);
+}
+
+// Copies bits [from, from + count) of `cells` (count <= 128) to `row` at `to`.
+void copyBits(const BrickCells& cells, std::uint64_t from, std::uint32_t count, std::uint64_t* row, std::uint32_t to) {
+  while (count > 0) {
+    std::uint32_t chunk = count < 64 ? count : 64;
+    insertBits(row, to, extractBits(cells.bits.data(), from, chunk), chunk);
+    from += chunk;
+    to += chunk;
+    count -= chunk;
+  }
+}
+
+// Which brick of the neighbourhood a brick-local coordinate in [-n, B+n) falls in, and where.
+struct AxisSplit {
+  int offset;       ///< -1, 0, 1
+  std::uint32_t local;
+};
+AxisSplit splitAxis(int coord, int brickSize) {
+  int offset = coord < 0 ? -1 : (coord >= brickSize ? 1 : 0);
+  return {offset, std::uint32_t(coord - offset * brickSize)};
+}
+
+void fillAttributes(BitBrick& out, const Neighbourhood<BrickCells>& cells) {
+  glm::uvec3 dims = out.subBrickDims();
+  int brickSize = int(out.brickSize), overlap = int(out.overlap);
+  out.rowOffsets.resize(std::size_t(dims.y) * dims.z);
+  out.subBrickOffsets.resize(out.subBricks.size());
+  std::uint32_t running = 0;
+  for (std::uint32_t row = 0; row < dims.y * dims.z; ++row) {
+    out.rowOffsets[row] = running;
+    glm::ivec3 rowOrigin(0, int(row % dims.y) * 4, int(row / dims.y) * 8);
+    for (std::uint32_t a = 0; a < dims.x; ++a) {
+      std::uint32_t index = row * dims.x + a;
+      out.subBrickOffsets[index] = std::uint16_t(running - out.rowOffsets[row]);
+      const glm::uvec4& sub = out.subBricks[index];
+      for (int w = 0; w < 4; ++w) {
+        for (std::uint32_t bits = sub[w]; bits != 0; bits &= bits - 1) {
+          std::uint32_t i = std::uint32_t(w) * 32 + std::countr_zero(bits);
+          glm::ivec3 stored = rowOrigin + glm::ivec3(int(a) * 4 + int(i & 3), int((i >> 2) & 3), int(i >> 4));
+          AxisSplit x = splitAxis(stored.x - overlap, brickSize);
+          AxisSplit y = splitAxis(stored.y - overlap, brickSize);
+          AxisSplit z = splitAxis(stored.z - overlap, brickSize);
+          const BrickCells& source = *cells[neighbourIndex(x.offset, y.offset, z.offset)];
+          std::uint32_t linear = x.local + out.brickSize * (y.local + out.brickSize * z.local);
+          std::uint64_t word = source.bits[linear >> 6];
+          std::uint32_t rank = source.wordRank[linear >> 6] +
+                               std::popcount(word & ((std::uint64_t(1) << (linear & 63)) - 1));
+          out.attributes.push_back(source.cellAttributes[rank]);
+          ++running;
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+
+void validate(const ConversionOptions& options) {
+  if (!isBrickSize(options.brickSize))
+    throw InputError("streaming: brick size must be 32, 64 or 128, got " + std::to_string(options.brickSize));
+  if (options.overlap > kMaxOverlap)
+    throw InputError("streaming: overlap must be at most " + std::to_string(kMaxOverlap) + " cells, got " +
+                     std::to_string(options.overlap));
+}
+
+std::uint32_t BitBrick::attributeBase(std::uint32_t index) const {
+  return rowOffsets[index / subBrickDims().x] + subBrickOffsets[index];
+}
+
+bool BitBrick::isSet(glm::ivec3 cell) const {
+  return bitBrickBitSet(subBricks[bitBrickSubBrickIndex(cell, brickSize, overlap)], bitBrickBitIndex(cell, overlap));
+}
+
+std::uint16_t BitBrick::attribute(glm::ivec3 cell) const {
+  std::uint32_t index = bitBrickSubBrickIndex(cell, brickSize, overlap);
+  return attributes[bitBrickAttributeOffset(attributeBase(index), subBricks[index], bitBrickBitIndex(cell, overlap))];
+}
+
+std::uint64_t BitBrick::setCells() const {
+  std::uint64_t count = 0;
+  for (const glm::uvec4& s : subBricks)
+    count += std::popcount(s.x) + std::popcount(s.y) + std::popcount(s.z) + std::popcount(s.w);
+  return count;
+}
+
+std::size_t BitBrick::bytes() const {
+  return subBricks.size() * sizeof(glm::uvec4) + rowOffsets.size() * 4 + subBrickOffsets.size() * 2 +
+         attributes.size() * 2;
+}
+
+std::size_t BrickCells::bytes() const { return bits.size() * 8 + wordRank.size() * 4 + cellAttributes.size() * 2; }
+
+BrickCells makeBrickCells(const DecodedBrick& brick, std::uint32_t brickSize, AttributeReduction reduction) {
+  FLIPSCOPE_CHECK(isBrickSize(brickSize), "brickSize=" << brickSize);
+  FLIPSCOPE_CHECK(brick.counts.size() == brick.cells.size(),
+                  "counts=" << brick.counts.size() << " cells=" << brick.cells.size());
+  const std::uint64_t cellsPerBrick = std::uint64_t(brickSize) * brickSize * brickSize;
+  BrickCells out;
+  out.brickSize = brickSize;
+  out.bits.assign(cellsPerBrick / 64 + 1, 0);
+  std::uint64_t previous = 0;
+  for (std::size_t i = 0; i < brick.cells.size(); ++i) {
+    std::uint32_t cell = brick.cells[i];
+    FLIPSCOPE_CHECK(cell < cellsPerBrick && (i == 0 || cell > previous),
+                    "cell " << i << " = " << cell << " after " << previous);
+    out.bits[cell >> 6] |= std::uint64_t(1) << (cell & 63);
+    previous = cell;
+  }
+  if (reduction == AttributeReduction::None) return out;
+
+  out.wordRank.resize(out.bits.size());
+  std::uint32_t rank = 0;
+  for (std::size_t w = 0; w < out.bits.size(); ++w) {
+    out.wordRank[w] = rank;
+    rank += std::popcount(out.bits[w]);
+  }
+  FLIPSCOPE_CHECK(brick.attributes.size() == brick.particleCount(),
+                  "attributes=" << brick.attributes.size() << " particles=" << brick.particleCount());
+  out.cellAttributes.resize(brick.cells.size());
+  std::size_t particle = 0;
+  for (std::size_t i = 0; i < brick.cells.size(); ++i) {
+    std::uint32_t count = brick.counts[i];
+    FLIPSCOPE_CHECK(count >= 1, "cell " << i << " has no particles");
+    std::uint64_t sum = 0;
+    std::uint16_t largest = 0;
+    for (std::uint32_t p = 0; p < count; ++p, ++particle) {
+      sum += brick.attributes[particle];
+      largest = std::max(largest, brick.attributes[particle]);
+    }
+    out.cellAttributes[i] = reduction == AttributeReduction::Max ? largest : std::uint16_t(sum / count);
+  }
+  return out;
+}
+
+BitBrick convertBrick(const Neighbourhood<BrickCells>& cells, const ConversionOptions& options) {
+  validate(options);
+  FLIPSCOPE_CHECK(cells[kCentre] != nullptr, "the centre brick is missing");
+  const bool withAttributes = options.attribute != AttributeReduction::None;
+  for (const BrickCells* c : cells) {
+    if (!c) continue;
+    FLIPSCOPE_CHECK(c->brickSize == options.brickSize, "brickSize=" << c->brickSize << " expected " << options.brickSize);
+    FLIPSCOPE_CHECK(!withAttributes || !c->wordRank.empty(), "a neighbour was built without attributes");
+  }
+  const std::uint32_t brickSize = options.brickSize, overlap = options.overlap;
+  const std::uint32_t stored = brickSize + 2 * overlap;
+  BitBrick out;
+  out.brickSize = brickSize;
+  out.overlap = overlap;
+  const glm::uvec3 dims = out.subBrickDims();
+  out.subBricks.assign(std::size_t(dims.x) * dims.y * dims.z, glm::uvec4(0));
+  auto* words = reinterpret_cast<std::uint32_t*>(out.subBricks.data());
+
+  for (std::uint32_t sz = 0; sz < stored; ++sz) {
+    AxisSplit z = splitAxis(int(sz) - int(overlap), int(brickSize));
+    for (std::uint32_t sy = 0; sy < stored; ++sy) {
+      AxisSplit y = splitAxis(int(sy) - int(overlap), int(brickSize));
+      const std::uint64_t rowStart = (std::uint64_t(z.local) * brickSize + y.local) * brickSize;
+      std::uint64_t row[3] = {0, 0, 0};  // stored x in [0, stored <= 144)
+      if (const BrickCells* c = cells[neighbourIndex(0, y.offset, z.offset)]) copyBits(*c, rowStart, brickSize, row, overlap);
+      if (overlap > 0) {
+        if (const BrickCells* c = cells[neighbourIndex(-1, y.offset, z.offset)])
+          copyBits(*c, rowStart + brickSize - overlap, overlap, row, 0);
+        if (const BrickCells* c = cells[neighbourIndex(1, y.offset, z.offset)])
+          copyBits(*c, rowStart, overlap, row, overlap + brickSize);
+      }
+      if ((row[0] | row[1] | row[2]) == 0) continue;
+      const std::uint32_t shift = 4 * (sy & 3) + 16 * (sz & 7);
+      std::uint32_t* target = words + std::size_t(4) * dims.x * ((sy >> 2) + dims.y * (sz >> 3)) + (shift >> 5);
+      const std::uint32_t bitShift = shift & 31;
+      for (std::uint32_t a = 0; a < dims.x; ++a)
+        target[4 * a] |= (std::uint32_t(row[a >> 4] >> ((a & 15) * 4)) & 15u) << bitShift;
+    }
+  }
+  if (withAttributes) fillAttributes(out, cells);
+  return out;
+}
+
+BitBrick convertBrick(const Neighbourhood<DecodedBrick>& bricks, const ConversionOptions& options) {
+  validate(options);
+  std::array<BrickCells, 27> built;
+  Neighbourhood<BrickCells> cells{};
+  for (int i = 0; i < 27; ++i) {
+    if (!bricks[i]) continue;
+    built[i] = makeBrickCells(*bricks[i], options.brickSize, options.attribute);
+    cells[i] = &built[i];
+  }
+  return convertBrick(cells, options);
+}
+
+}  // namespace flipscope
