@@ -129,14 +129,22 @@ BrickCells makeBrickCells(const DecodedBrick& brick, std::uint32_t brickSize, At
   BrickCells out;
   out.brickSize = brickSize;
   out.bits.assign(cellsPerBrick / 64 + 1, 0);
-  std::uint64_t previous = 0;
-  for (std::size_t i = 0; i < brick.cells.size(); ++i) {
-    std::uint32_t cell = brick.cells[i];
-    FLIPSCOPE_CHECK(cell < cellsPerBrick && (i == 0 || cell > previous),
-                    "cell " << i << " = " << cell << " after " << previous);
-    out.bits[cell >> 6] |= std::uint64_t(1) << (cell & 63);
+  if (!brick.cells.empty())
+    FLIPSCOPE_CHECK(brick.cells.back() < cellsPerBrick, "last cell " << brick.cells.back() << " >= " << cellsPerBrick);
+  // Cells ascend: gather each word in a register and store it once.
+  std::uint64_t word = 0, wordIndex = 0;
+  std::int64_t previous = -1;
+  for (std::uint32_t cell : brick.cells) {
+    FLIPSCOPE_CHECK(std::int64_t(cell) > previous, "cells not ascending: " << cell << " after " << previous);
+    if ((cell >> 6) != wordIndex) {
+      out.bits[wordIndex] = word;
+      word = 0;
+      wordIndex = cell >> 6;
+    }
+    word |= std::uint64_t(1) << (cell & 63);
     previous = cell;
   }
+  out.bits[wordIndex] |= word;
   if (reduction == AttributeReduction::None) return out;
 
   out.wordRank.resize(out.bits.size());
@@ -181,27 +189,40 @@ BitBrick convertBrick(const Neighbourhood<BrickCells>& cells, const ConversionOp
   out.subBricks.assign(std::size_t(dims.x) * dims.y * dims.z, glm::uvec4(0));
   auto* words = reinterpret_cast<std::uint32_t*>(out.subBricks.data());
 
-  for (std::uint32_t sz = 0; sz < stored; ++sz) {
+  // Stored row (sy, sz), x in [0, stored <= 144) as three words, from up to three bricks.
+  auto buildRow = [&](std::uint32_t sy, std::uint32_t sz, std::uint64_t* row) {
+    AxisSplit y = splitAxis(int(sy) - int(overlap), int(brickSize));
     AxisSplit z = splitAxis(int(sz) - int(overlap), int(brickSize));
-    for (std::uint32_t sy = 0; sy < stored; ++sy) {
-      AxisSplit y = splitAxis(int(sy) - int(overlap), int(brickSize));
-      const std::uint64_t rowStart = (std::uint64_t(z.local) * brickSize + y.local) * brickSize;
-      std::uint64_t row[3] = {0, 0, 0};  // stored x in [0, stored <= 144)
-      if (const BrickCells* c = cells[neighbourIndex(0, y.offset, z.offset)]) copyBits(*c, rowStart, brickSize, row, overlap);
-      if (overlap > 0) {
-        if (const BrickCells* c = cells[neighbourIndex(-1, y.offset, z.offset)])
-          copyBits(*c, rowStart + brickSize - overlap, overlap, row, 0);
-        if (const BrickCells* c = cells[neighbourIndex(1, y.offset, z.offset)])
-          copyBits(*c, rowStart, overlap, row, overlap + brickSize);
+    const std::uint64_t rowStart = (std::uint64_t(z.local) * brickSize + y.local) * brickSize;
+    if (const BrickCells* c = cells[neighbourIndex(0, y.offset, z.offset)]) copyBits(*c, rowStart, brickSize, row, overlap);
+    if (overlap == 0) return;
+    if (const BrickCells* c = cells[neighbourIndex(-1, y.offset, z.offset)])
+      copyBits(*c, rowStart + brickSize - overlap, overlap, row, 0);
+    if (const BrickCells* c = cells[neighbourIndex(1, y.offset, z.offset)])
+      copyBits(*c, rowStart, overlap, row, overlap + brickSize);
+  };
+  // Word w of the sub-bricks in row (b, c) holds 8 stored rows: nibble k is row
+  // (4b + (k&3), 8c + 2w + (k>>2)). Each word is written once, from registers.
+  for (std::uint32_t c = 0; c < dims.z; ++c)
+    for (std::uint32_t b = 0; b < dims.y; ++b)
+      for (std::uint32_t w = 0; w < 4; ++w) {
+        std::uint64_t rows[8][3] = {};
+        std::uint64_t any = 0;
+        for (std::uint32_t k = 0; k < 8; ++k) {
+          std::uint32_t sy = 4 * b + (k & 3), sz = 8 * c + 2 * w + (k >> 2);
+          if (sy >= stored || sz >= stored) continue;
+          buildRow(sy, sz, rows[k]);
+          any |= rows[k][0] | rows[k][1] | rows[k][2];
+        }
+        if (any == 0) continue;
+        std::uint32_t* target = words + std::size_t(4) * dims.x * (b + dims.y * c) + w;
+        for (std::uint32_t a = 0; a < dims.x; ++a) {
+          const std::uint32_t chunk = a >> 4, shift = (a & 15) * 4;
+          std::uint32_t word = 0;
+          for (std::uint32_t k = 0; k < 8; ++k) word |= (std::uint32_t(rows[k][chunk] >> shift) & 15u) << (4 * k);
+          target[4 * a] = word;
+        }
       }
-      if ((row[0] | row[1] | row[2]) == 0) continue;
-      const std::uint32_t shift = 4 * (sy & 3) + 16 * (sz & 7);
-      std::uint32_t* target = words + std::size_t(4) * dims.x * ((sy >> 2) + dims.y * (sz >> 3)) + (shift >> 5);
-      const std::uint32_t bitShift = shift & 31;
-      for (std::uint32_t a = 0; a < dims.x; ++a)
-        target[4 * a] |= (std::uint32_t(row[a >> 4] >> ((a & 15) * 4)) & 15u) << bitShift;
-    }
-  }
   if (withAttributes) fillAttributes(out, cells);
   return out;
 }
