@@ -3,6 +3,7 @@
 // border of §3.3.1 and the attribute storage of §3.2.
 #include "streaming/BitBrick.h"
 
+#include <algorithm>
 #include <bit>
 #include <string>
 
@@ -39,6 +40,14 @@ void copyBits(const BrickCells& cells, std::uint64_t from, std::uint32_t count, 
     to += chunk;
     count -= chunk;
   }
+}
+
+// The eight nibbles of v into the low nibbles of eight bytes.
+std::uint64_t spreadNibbles(std::uint32_t v) {
+  std::uint64_t x = v;
+  x = (x | x << 16) & 0x0000ffff0000ffffull;
+  x = (x | x << 8) & 0x00ff00ff00ff00ffull;
+  return (x | x << 4) & 0x0f0f0f0f0f0f0f0full;
 }
 
 // Which brick of the neighbourhood a brick-local coordinate in [-n, B+n) falls in, and where.
@@ -216,11 +225,20 @@ BitBrick convertBrick(const Neighbourhood<BrickCells>& cells, const ConversionOp
         }
         if (any == 0) continue;
         std::uint32_t* target = words + std::size_t(4) * dims.x * (b + dims.y * c) + w;
-        for (std::uint32_t a = 0; a < dims.x; ++a) {
-          const std::uint32_t chunk = a >> 4, shift = (a & 15) * 4;
-          std::uint32_t word = 0;
-          for (std::uint32_t k = 0; k < 8; ++k) word |= (std::uint32_t(rows[k][chunk] >> shift) & 15u) << (4 * k);
-          target[4 * a] = word;
+        // Eight sub-bricks at a time: spread each row's eight nibbles to bytes, pair rows into
+        // nibble pairs, then gather byte j of the four pairs into sub-brick j's word.
+        for (std::uint32_t a0 = 0; a0 < dims.x; a0 += 8) {
+          std::uint64_t pairs[4];
+          for (std::uint32_t m = 0; m < 4; ++m) {
+            const std::uint32_t shift = (a0 & 15) * 4;
+            pairs[m] = spreadNibbles(std::uint32_t(rows[2 * m][a0 >> 4] >> shift)) |
+                       spreadNibbles(std::uint32_t(rows[2 * m + 1][a0 >> 4] >> shift)) << 4;
+          }
+          const std::uint32_t count = std::min(8u, dims.x - a0);
+          for (std::uint32_t j = 0; j < count; ++j)
+            target[4 * (a0 + j)] = std::uint32_t(pairs[0] >> (8 * j) & 0xff) | std::uint32_t(pairs[1] >> (8 * j) & 0xff) << 8 |
+                                   std::uint32_t(pairs[2] >> (8 * j) & 0xff) << 16 |
+                                   std::uint32_t(pairs[3] >> (8 * j) & 0xff) << 24;
         }
       }
   if (withAttributes) fillAttributes(out, cells);
