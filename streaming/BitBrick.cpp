@@ -16,30 +16,17 @@ static_assert(sizeof(glm::uvec4) == 16, "sub-bricks are addressed as 4 consecuti
 
 bool isBrickSize(std::uint32_t size) { return size == 32 || size == 64 || size == 128; }
 
-// Bits [pos, pos + count) of a bitset, count <= 64; the bitset has a padding word at its end.
-std::uint64_t extractBits(const std::uint64_t* words, std::uint64_t pos, std::uint32_t count) {
-  std::uint64_t word = pos >> 6;
-  std::uint32_t shift = pos & 63;
-  std::uint64_t value = words[word] >> shift;
-  if (shift != 0 && shift + count > 64) value |= words[word + 1] << (64 - shift);
-  return count < 64 ? value & ((std::uint64_t(1) << count) - 1) : value;
+// Bits [pos, pos + count) of a row that lies in one 64-bit word of a bitset (rows of 32 cells
+// share a word; rows of 64 and 128 cells start at a word), count < 64.
+std::uint64_t rowBits(const std::uint64_t* words, std::uint64_t pos, std::uint32_t count) {
+  return (words[pos >> 6] >> (pos & 63)) & ((std::uint64_t(1) << count) - 1);
 }
 
+// ORs `count` (<= 64) bits into a stored row at bit `pos`.
 void insertBits(std::uint64_t* row, std::uint32_t pos, std::uint64_t value, std::uint32_t count) {
   std::uint32_t shift = pos & 63;
   row[pos >> 6] |= value << shift;
   if (shift != 0 && shift + count > 64) row[(pos >> 6) + 1] |= value >> (64 - shift);
-}
-
-// Copies bits [from, from + count) of `cells` (count <= 128) to `row` at `to`.
-void copyBits(const BrickCells& cells, std::uint64_t from, std::uint32_t count, std::uint64_t* row, std::uint32_t to) {
-  while (count > 0) {
-    std::uint32_t chunk = count < 64 ? count : 64;
-    insertBits(row, to, extractBits(cells.bits.data(), from, chunk), chunk);
-    from += chunk;
-    to += chunk;
-    count -= chunk;
-  }
 }
 
 // The eight nibbles of v into the low nibbles of eight bytes.
@@ -203,12 +190,19 @@ BitBrick convertBrick(const Neighbourhood<BrickCells>& cells, const ConversionOp
     AxisSplit y = splitAxis(int(sy) - int(overlap), int(brickSize));
     AxisSplit z = splitAxis(int(sz) - int(overlap), int(brickSize));
     const std::uint64_t rowStart = (std::uint64_t(z.local) * brickSize + y.local) * brickSize;
-    if (const BrickCells* c = cells[neighbourIndex(0, y.offset, z.offset)]) copyBits(*c, rowStart, brickSize, row, overlap);
+    if (const BrickCells* c = cells[neighbourIndex(0, y.offset, z.offset)]) {
+      const std::uint64_t* words = c->bits.data();
+      if (brickSize == 32) {
+        row[0] |= rowBits(words, rowStart, 32) << overlap;
+      } else {
+        for (std::uint32_t i = 0; i < brickSize / 64; ++i) insertBits(row, overlap + 64 * i, words[(rowStart >> 6) + i], 64);
+      }
+    }
     if (overlap == 0) return;
     if (const BrickCells* c = cells[neighbourIndex(-1, y.offset, z.offset)])
-      copyBits(*c, rowStart + brickSize - overlap, overlap, row, 0);
+      row[0] |= rowBits(c->bits.data(), rowStart + brickSize - overlap, overlap);
     if (const BrickCells* c = cells[neighbourIndex(1, y.offset, z.offset)])
-      copyBits(*c, rowStart, overlap, row, overlap + brickSize);
+      insertBits(row, overlap + brickSize, rowBits(c->bits.data(), rowStart, overlap), overlap);
   };
   // Word w of the sub-bricks in row (b, c) holds 8 stored rows: nibble k is row
   // (4b + (k&3), 8c + 2w + (k>>2)). Each word is written once, from registers.
