@@ -18,23 +18,28 @@ bool isBrickSize(std::uint32_t size) { return size == 32 || size == 64 || size =
 
 // Bits [pos, pos + count) of a row that lies in one 64-bit word of a bitset (rows of 32 cells
 // share a word; rows of 64 and 128 cells start at a word), count < 64.
-std::uint64_t rowBits(const std::uint64_t* words, std::uint64_t pos, std::uint32_t count) {
+[[gnu::always_inline]] inline std::uint64_t rowBits(const std::uint64_t* words, std::uint64_t pos, std::uint32_t count) {
   return (words[pos >> 6] >> (pos & 63)) & ((std::uint64_t(1) << count) - 1);
 }
 
 // ORs `count` (<= 64) bits into a stored row at bit `pos`.
-void insertBits(std::uint64_t* row, std::uint32_t pos, std::uint64_t value, std::uint32_t count) {
+[[gnu::always_inline]] inline void insertBits(std::uint64_t* row, std::uint32_t pos, std::uint64_t value, std::uint32_t count) {
   std::uint32_t shift = pos & 63;
   row[pos >> 6] |= value << shift;
   if (shift != 0 && shift + count > 64) row[(pos >> 6) + 1] |= value >> (64 - shift);
 }
 
-// The eight nibbles of v into the low nibbles of eight bytes.
-std::uint64_t spreadNibbles(std::uint32_t v) {
-  std::uint64_t x = v;
-  x = (x | x << 16) & 0x0000ffff0000ffffull;
-  x = (x | x << 8) & 0x00ff00ff00ff00ffull;
-  return (x | x << 4) & 0x0f0f0f0f0f0f0f0full;
+// Transposes two 8x8 matrices of nibbles at once, in place: matrix h (0, 1) has element
+// (row, column) at m[row] >> (32*h + 4*column). Recursive block swaps: 4x4, 2x2, 1x1.
+[[gnu::always_inline]] inline void transposeNibbles8x8x2(std::uint64_t* m) {
+  auto swap = [m](int a, int b, int shift, std::uint64_t mask) {
+    std::uint64_t t = ((m[a] >> shift) ^ m[b]) & mask;
+    m[b] ^= t;
+    m[a] ^= t << shift;
+  };
+  for (int k = 0; k < 4; ++k) swap(k, k + 4, 16, 0x0000ffff0000ffffull);
+  for (int k : {0, 1, 4, 5}) swap(k, k + 2, 8, 0x00ff00ff00ff00ffull);
+  for (int k : {0, 2, 4, 6}) swap(k, k + 1, 4, 0x0f0f0f0f0f0f0f0full);
 }
 
 // Which brick of the neighbourhood a brick-local coordinate in [-n, B+n) falls in, and where.
@@ -219,20 +224,14 @@ BitBrick convertBrick(const Neighbourhood<BrickCells>& cells, const ConversionOp
         }
         if (any == 0) continue;
         std::uint32_t* target = words + std::size_t(4) * dims.x * (b + dims.y * c) + w;
-        // Eight sub-bricks at a time: spread each row's eight nibbles to bytes, pair rows into
-        // nibble pairs, then gather byte j of the four pairs into sub-brick j's word.
-        for (std::uint32_t a0 = 0; a0 < dims.x; a0 += 8) {
-          std::uint64_t pairs[4];
-          for (std::uint32_t m = 0; m < 4; ++m) {
-            const std::uint32_t shift = (a0 & 15) * 4;
-            pairs[m] = spreadNibbles(std::uint32_t(rows[2 * m][a0 >> 4] >> shift)) |
-                       spreadNibbles(std::uint32_t(rows[2 * m + 1][a0 >> 4] >> shift)) << 4;
-          }
-          const std::uint32_t count = std::min(8u, dims.x - a0);
-          for (std::uint32_t j = 0; j < count; ++j)
-            target[4 * (a0 + j)] = std::uint32_t(pairs[0] >> (8 * j) & 0xff) | std::uint32_t(pairs[1] >> (8 * j) & 0xff) << 8 |
-                                   std::uint32_t(pairs[2] >> (8 * j) & 0xff) << 16 |
-                                   std::uint32_t(pairs[3] >> (8 * j) & 0xff) << 24;
+        // Sixteen sub-bricks at a time: the nibbles of the eight rows form two 8x8 nibble
+        // matrices (row k, column j = sub-brick a0 + j); their transposes hold the words.
+        for (std::uint32_t a0 = 0; a0 < dims.x; a0 += 16) {
+          std::uint64_t m[8];
+          for (std::uint32_t k = 0; k < 8; ++k) m[k] = rows[k][a0 >> 4];
+          transposeNibbles8x8x2(m);
+          const std::uint32_t count = std::min(16u, dims.x - a0);
+          for (std::uint32_t j = 0; j < count; ++j) target[4 * (a0 + j)] = std::uint32_t(m[j & 7] >> (32 * (j >> 3)));
         }
       }
   if (withAttributes) fillAttributes(out, cells);
