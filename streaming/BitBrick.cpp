@@ -18,12 +18,14 @@ bool isBrickSize(std::uint32_t size) { return size == 32 || size == 64 || size =
 
 // Bits [pos, pos + count) of a row that lies in one 64-bit word of a bitset (rows of 32 cells
 // share a word; rows of 64 and 128 cells start at a word), count < 64.
-[[gnu::always_inline]] inline std::uint64_t rowBits(const std::uint64_t* words, std::uint64_t pos, std::uint32_t count) {
+[[gnu::always_inline]] inline std::uint64_t rowBits(const std::uint64_t* words, std::uint64_t pos,
+                                                    std::uint32_t count) {
   return (words[pos >> 6] >> (pos & 63)) & ((std::uint64_t(1) << count) - 1);
 }
 
 // ORs `count` (<= 64) bits into a stored row at bit `pos`.
-[[gnu::always_inline]] inline void insertBits(std::uint64_t* row, std::uint32_t pos, std::uint64_t value, std::uint32_t count) {
+[[gnu::always_inline]] inline void insertBits(std::uint64_t* row, std::uint32_t pos, std::uint64_t value,
+                                              std::uint32_t count) {
   std::uint32_t shift = pos & 63;
   row[pos >> 6] |= value << shift;
   if (shift != 0 && shift + count > 64) row[(pos >> 6) + 1] |= value >> (64 - shift);
@@ -44,7 +46,7 @@ bool isBrickSize(std::uint32_t size) { return size == 32 || size == 64 || size =
 
 // Which brick of the neighbourhood a brick-local coordinate in [-n, B+n) falls in, and where.
 struct AxisSplit {
-  int offset;       ///< -1, 0, 1
+  int offset;  ///< -1, 0, 1
   std::uint32_t local;
 };
 AxisSplit splitAxis(int coord, int brickSize) {
@@ -75,8 +77,8 @@ void fillAttributes(BitBrick& out, const Neighbourhood<BrickCells>& cells) {
           const BrickCells& source = *cells[neighbourIndex(x.offset, y.offset, z.offset)];
           std::uint32_t linear = x.local + out.brickSize * (y.local + out.brickSize * z.local);
           std::uint64_t word = source.bits[linear >> 6];
-          std::uint32_t rank = source.wordRank[linear >> 6] +
-                               std::popcount(word & ((std::uint64_t(1) << (linear & 63)) - 1));
+          std::uint32_t rank =
+              source.wordRank[linear >> 6] + std::popcount(word & ((std::uint64_t(1) << (linear & 63)) - 1));
           out.attributes.push_back(source.cellAttributes[rank]);
           ++running;
         }
@@ -178,7 +180,8 @@ BitBrick convertBrick(const Neighbourhood<BrickCells>& cells, const ConversionOp
   const bool withAttributes = options.attribute != AttributeReduction::None;
   for (const BrickCells* c : cells) {
     if (!c) continue;
-    FLIPSCOPE_CHECK(c->brickSize == options.brickSize, "brickSize=" << c->brickSize << " expected " << options.brickSize);
+    FLIPSCOPE_CHECK(c->brickSize == options.brickSize,
+                    "brickSize=" << c->brickSize << " expected " << options.brickSize);
     FLIPSCOPE_CHECK(!withAttributes || !c->wordRank.empty(), "a neighbour was built without attributes");
   }
   const std::uint32_t brickSize = options.brickSize, overlap = options.overlap;
@@ -200,7 +203,8 @@ BitBrick convertBrick(const Neighbourhood<BrickCells>& cells, const ConversionOp
       if (brickSize == 32) {
         row[0] |= rowBits(words, rowStart, 32) << overlap;
       } else {
-        for (std::uint32_t i = 0; i < brickSize / 64; ++i) insertBits(row, overlap + 64 * i, words[(rowStart >> 6) + i], 64);
+        for (std::uint32_t i = 0; i < brickSize / 64; ++i)
+          insertBits(row, overlap + 64 * i, words[(rowStart >> 6) + i], 64);
       }
     }
     if (overlap == 0) return;

@@ -44,10 +44,10 @@ void validate(const ConversionOptions& options);
 struct BitBrick {
   std::uint32_t brickSize = 0;
   std::uint32_t overlap = 0;
-  std::vector<glm::uvec4> subBricks;            ///< bitBrickSubBrickDims() product, GLSL layout
-  std::vector<std::uint32_t> rowOffsets;        ///< per sub-brick row b + sy*c; empty without attributes
-  std::vector<std::uint16_t> subBrickOffsets;   ///< per sub-brick, relative to its row
-  std::vector<std::uint16_t> attributes;        ///< one per set stored cell
+  std::vector<glm::uvec4> subBricks;           ///< bitBrickSubBrickDims() product, GLSL layout
+  std::vector<std::uint32_t> rowOffsets;       ///< per sub-brick row b + sy*c; empty without attributes
+  std::vector<std::uint16_t> subBrickOffsets;  ///< per sub-brick, relative to its row
+  std::vector<std::uint16_t> attributes;       ///< one per set stored cell
 
   glm::uvec3 subBrickDims() const { return bitBrickSubBrickDims(brickSize, overlap); }
   bool hasAttributes() const { return !rowOffsets.empty(); }
@@ -66,9 +66,9 @@ struct BitBrick {
 /// A decoded brick's occupied cells as a flat bitset, plus what attribute lookups need.
 struct BrickCells {
   std::uint32_t brickSize = 0;
-  std::vector<std::uint64_t> bits;              ///< bit x + B*(y + B*z); one padding word at the end
-  std::vector<std::uint32_t> wordRank;          ///< set bits before each word (with attributes only)
-  std::vector<std::uint16_t> cellAttributes;    ///< reduced value per occupied cell, in cell order
+  std::vector<std::uint64_t> bits;            ///< bit x + B*(y + B*z); one padding word at the end
+  std::vector<std::uint32_t> wordRank;        ///< set bits before each word (with attributes only)
+  std::vector<std::uint16_t> cellAttributes;  ///< reduced value per occupied cell, in cell order
 
   bool isSet(std::uint32_t linearCell) const { return (bits[linearCell >> 6] >> (linearCell & 63)) & 1u; }
   std::size_t bytes() const;

@@ -37,7 +37,9 @@ std::vector<std::uint32_t> buildBrickMipmap(const BitBrick& brick, std::uint32_t
   const std::uint32_t size = brick.brickSize, overlap = brick.overlap;
   const std::uint32_t levels = bitBrickMipLevelCount(size, overlap);
   std::vector<std::uint32_t> mip(bitBrickMipWordOffset(levels + 1, size, overlap), 0);
-  auto setBit = [&mip](std::uint32_t wordOffset, std::uint32_t bit) { mip[wordOffset + (bit >> 5)] |= 1u << (bit & 31); };
+  auto setBit = [&mip](std::uint32_t wordOffset, std::uint32_t bit) {
+    mip[wordOffset + (bit >> 5)] |= 1u << (bit & 31);
+  };
   auto isBitSet = [&mip](std::uint32_t wordOffset, std::uint32_t bit) {
     return (mip[wordOffset + (bit >> 5)] >> (bit & 31) & 1u) != 0;
   };
@@ -59,7 +61,8 @@ std::vector<std::uint32_t> buildBrickMipmap(const BitBrick& brick, std::uint32_t
           for (int j = -reach.y; j <= reach.y && !occupied; ++j)
             for (int i = -reach.x; i <= reach.x && !occupied; ++i) {
               glm::ivec3 source(a + i, b + j, c + k);
-              if (glm::any(glm::lessThan(source, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(source, dims))) continue;
+              if (glm::any(glm::lessThan(source, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(source, dims)))
+                continue;
               glm::uvec4 bits = brick.subBricks[source.x + dims.x * (source.y + dims.y * source.z)];
               glm::uvec4 mask = masks[(i + reach.x) + span.x * ((j + reach.y) + span.y * (k + reach.z))];
               occupied = ((bits.x & mask.x) | (bits.y & mask.y) | (bits.z & mask.z) | (bits.w & mask.w)) != 0;

@@ -55,7 +55,8 @@ ConvertedBrick decompressConvertedBrick(std::span<const std::byte> bytes) {
   ByteReader header(bytes, kCacheName);
   auto rawSize = header.get<std::uint64_t>("raw size");
   std::vector<std::byte> raw(rawSize);
-  std::size_t read = ZSTD_decompress(raw.data(), raw.size(), bytes.data() + sizeof(rawSize), bytes.size() - sizeof(rawSize));
+  std::size_t read =
+      ZSTD_decompress(raw.data(), raw.size(), bytes.data() + sizeof(rawSize), bytes.size() - sizeof(rawSize));
   FLIPSCOPE_CHECK(!ZSTD_isError(read) && read == rawSize, "decompressed " << read << " of " << rawSize);
   ByteReader in(raw, kCacheName);
   ConvertedBrick brick;

@@ -35,21 +35,21 @@ namespace flipscope {
 
 struct StreamerOptions {
   ConversionOptions conversion;
-  std::uint32_t mipDilation = 0;              ///< see buildBrickMipmap; <= kMaxMipDilation
+  std::uint32_t mipDilation = 0;  ///< see buildBrickMipmap; <= kMaxMipDilation
   unsigned threads = 2;
-  std::size_t cacheBytes = std::size_t(1) << 30;      ///< converted bricks, all frames
+  std::size_t cacheBytes = std::size_t(1) << 30;  ///< converted bricks, all frames
   bool compressCache = false;
   std::size_t neighbourCacheBytes = std::size_t(256) << 20;  ///< BrickCells of recent bricks
-  std::size_t maxReady = 1024;                ///< ready bricks before workers pause
+  std::size_t maxReady = 1024;                               ///< ready bricks before workers pause
   int readAheadFrames = 0;
 };
 
 struct StreamerStats {
-  std::uint64_t converted = 0;   ///< conversions done
-  std::uint64_t merged = 0;      ///< requests already pending, in flight or ready
-  std::uint64_t cancelled = 0;   ///< pending requests dropped by setFrame()
-  std::uint64_t failed = 0;      ///< bricks whose source threw (the error is kept, see lastError)
-  std::uint64_t delivered = 0;   ///< current-frame requests completed (ready, or empty bricks)
+  std::uint64_t converted = 0;           ///< conversions done
+  std::uint64_t merged = 0;              ///< requests already pending, in flight or ready
+  std::uint64_t cancelled = 0;           ///< pending requests dropped by setFrame()
+  std::uint64_t failed = 0;              ///< bricks whose source threw (the error is kept, see lastError)
+  std::uint64_t delivered = 0;           ///< current-frame requests completed (ready, or empty bricks)
   std::uint64_t deliveredFromCache = 0;  ///< of those, served by the converted-brick cache
   double cacheHitRate() const { return delivered ? double(deliveredFromCache) / double(delivered) : 0.0; }
 };
@@ -87,10 +87,10 @@ class Streamer {
   void work();
   std::shared_ptr<const ConvertedBrick> convert(const BrickKey& key);
   std::shared_ptr<const BrickCells> cellsOf(const BrickKey& key);
-  bool inWindow(int frame) const;           // caller holds mMutex
+  bool inWindow(int frame) const;                   // caller holds mMutex
   void queue(const BrickKey& key, bool readAhead);  // caller holds mMutex
   void queueReadAhead(glm::uvec3 coord);            // caller holds mMutex
-  bool hasRunnable() const;                 // caller holds mMutex
+  bool hasRunnable() const;                         // caller holds mMutex
 
   std::shared_ptr<BrickSource> mSource;
   StreamerOptions mOptions;

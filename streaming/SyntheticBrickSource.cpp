@@ -31,7 +31,8 @@ std::shared_ptr<const DecodedBrick> SyntheticBrickSource::read(const BrickKey& k
     for (std::uint32_t y = 0; y < b; ++y)
       for (std::uint32_t x = 0; x < b; ++x) {
         if (double(origin.z + z) >= heights[x + b * y]) continue;
-        glm::uvec2 hash = tea(glm::uvec2(mortonEncode3(origin.x + x, origin.y + y, origin.z + z), std::uint32_t(key.frame)), 4);
+        glm::uvec2 hash =
+            tea(glm::uvec2(mortonEncode3(origin.x + x, origin.y + y, origin.z + z), std::uint32_t(key.frame)), 4);
         if (hash.x > threshold) continue;
         std::uint32_t count = 1 + (hash.y & 1);
         brick->cells.push_back(x + b * (y + b * z));
@@ -52,8 +53,7 @@ std::vector<glm::uvec3> SyntheticBrickSource::bricks(int frame) const {
         // A brick is non-empty when the surface rises above its floor somewhere (sampled on its columns).
         bool below = false;
         for (double sy = 0; sy < b && !below; sy += 1)
-          for (double sx = 0; sx < b && !below; sx += 1)
-            below = surfaceHeight(frame, x * b + sx, y * b + sy) > z * b;
+          for (double sx = 0; sx < b && !below; sx += 1) below = surfaceHeight(frame, x * b + sx, y * b + sy) > z * b;
         if (below) out.push_back({x, y, z});
       }
   return out;

@@ -22,8 +22,8 @@ namespace {
 // Paper-like fill: 64^3 bricks with a 4-cell border at Step's 5.85 bits per particle, one
 // particle per cell, give 72^3 / 5.85 / 64^3 = 24 % occupied cells.
 constexpr double kPaperFill = 0.25;
-constexpr std::uint32_t kOverlap = 4;     // sphere radius 2 cells (Table 2) + jitter 1 + 1
-constexpr std::uint32_t kDilation = 3;    // radius + jitter
+constexpr std::uint32_t kOverlap = 4;   // sphere radius 2 cells (Table 2) + jitter 1 + 1
+constexpr std::uint32_t kDilation = 3;  // radius + jitter
 
 struct PaperRow {
   std::uint32_t size;
@@ -92,7 +92,8 @@ ConversionRow benchConversion(std::uint32_t size, double fill, int reps) {
   std::vector<std::uint32_t> mip;
   row.cells = timeMs(reps, [&] { cells = makeBrickCells(brick, size, options.attribute); });
   row.assemble = timeMs(reps, [&] { converted = convertBrick(around, options); });
-  row.conv = timeMs(reps, [&] { converted = convertBrick(around, options), cells = makeBrickCells(brick, size, options.attribute); });
+  row.conv = timeMs(
+      reps, [&] { converted = convertBrick(around, options), cells = makeBrickCells(brick, size, options.attribute); });
   row.cold = timeMs(std::max(1, reps / 10), [&] { converted = convertBrick(decoded, options); });
   row.mip = timeMs(reps, [&] { mip = buildBrickMipmap(converted, kDilation); });
   row.bitsPerParticle = double(converted.bytes() * 8) / double(brick.particleCount());
@@ -157,7 +158,8 @@ void run(bool json, int reps) {
     out["ms_per_brick_64"] = msPerBrick64;
     out["ms_per_brick_64_fill"] = kPaperFill;
     out["ms_per_brick_64_note"] =
-        "thread CPU time on one core; BrickCells of the brick (once per decoded brick) + assembly with a full 4-cell border; "
+        "thread CPU time on one core; BrickCells of the brick (once per decoded brick) + assembly with a full 4-cell "
+        "border; "
         "fill = fraction of occupied cells, paper-like from Table 1 Step (5.85 bits/particle)";
     for (const auto& r : rows)
       out["conversion"].push_back({{"brick_size", r.size},
@@ -170,26 +172,34 @@ void run(bool json, int reps) {
                                    {"mip_ms", r.mip.mean},
                                    {"bits_per_particle", r.bitsPerParticle}});
     for (const auto& p : kPaperTable2)
-      out["paper_table2"].push_back({{"brick_size", p.size}, {"conv_ms", p.conv}, {"conv_ms_spread", p.convSpread}, {"mip_ms", p.mip}});
+      out["paper_table2"].push_back(
+          {{"brick_size", p.size}, {"conv_ms", p.conv}, {"conv_ms_spread", p.convSpread}, {"mip_ms", p.mip}});
     for (const auto& s : scrubs)
-      out["cache"].push_back({{"name", s.name}, {"budget_bytes", s.budget}, {"hit_rate_per_pass", s.hitRatePerPass}, {"cache_bytes", s.cacheBytes}});
+      out["cache"].push_back({{"name", s.name},
+                              {"budget_bytes", s.budget},
+                              {"hit_rate_per_pass", s.hitRatePerPass},
+                              {"cache_bytes", s.cacheBytes}});
     std::printf("%s\n", out.dump(2).c_str());
     return;
   }
-  std::printf("Brick conversion, thread CPU time on one core, overlap %u cells, mip dilation %u, no attributes (ms per brick, mean +- sd)\n", kOverlap, kDilation);
-  std::printf("%5s %5s | %14s %9s %9s %9s %9s %6s | %11s %5s\n", "size", "fill", "conv", "cells", "assemble", "cold(27)",
-              "mip", "bits/p", "paper conv", "mip");
+  std::printf(
+      "Brick conversion, thread CPU time on one core, overlap %u cells, mip dilation %u, no attributes (ms per brick, "
+      "mean +- sd)\n",
+      kOverlap, kDilation);
+  std::printf("%5s %5s | %14s %9s %9s %9s %9s %6s | %11s %5s\n", "size", "fill", "conv", "cells", "assemble",
+              "cold(27)", "mip", "bits/p", "paper conv", "mip");
   for (const auto& r : rows) {
     const PaperRow* p = nullptr;
     for (const auto& q : kPaperTable2)
       if (q.size == r.size) p = &q;
-    std::printf("%5u %4.0f%% | %6.3f +- %5.3f %9.3f %9.3f %9.3f %9.3f %6.2f | %4.2f +- %4.2f %5.2f\n", r.size, r.fill * 100,
-                r.conv.mean, r.conv.spread, r.cells.mean, r.assemble.mean, r.cold.mean, r.mip.mean, r.bitsPerParticle,
-                p->conv, p->convSpread, p->mip);
+    std::printf("%5u %4.0f%% | %6.3f +- %5.3f %9.3f %9.3f %9.3f %9.3f %6.2f | %4.2f +- %4.2f %5.2f\n", r.size,
+                r.fill * 100, r.conv.mean, r.conv.spread, r.cells.mean, r.assemble.mean, r.cold.mean, r.mip.mean,
+                r.bitsPerParticle, p->conv, p->convSpread, p->mip);
   }
-  std::printf("ms_per_brick_64 (fill %.0f%%, paper-like): %.3f ms (paper 0.22 +- 0.06, target 0.10)\n", kPaperFill * 100,
-              msPerBrick64);
-  std::printf("\nCache hit rate, scrubbing 12 synthetic frames (32^3 bricks) forward, back, forward, back; read-ahead 2\n");
+  std::printf("ms_per_brick_64 (fill %.0f%%, paper-like): %.3f ms (paper 0.22 +- 0.06, target 0.10)\n",
+              kPaperFill * 100, msPerBrick64);
+  std::printf(
+      "\nCache hit rate, scrubbing 12 synthetic frames (32^3 bricks) forward, back, forward, back; read-ahead 2\n");
   for (const auto& s : scrubs) {
     std::printf("  %-20s", s.name.c_str());
     for (double h : s.hitRatePerPass) std::printf(" %5.1f%%", h * 100);
@@ -200,7 +210,8 @@ void run(bool json, int reps) {
 }  // namespace
 
 void addBenchStreamingCommand(CLI::App& bench) {
-  auto* cmd = bench.add_subcommand("streaming", "Brick conversion, mipmap and cache timings beside the paper's Table 2");
+  auto* cmd =
+      bench.add_subcommand("streaming", "Brick conversion, mipmap and cache timings beside the paper's Table 2");
   auto json = std::make_shared<bool>(false);
   auto reps = std::make_shared<int>(200);
   cmd->add_flag("--json", *json, "Print JSON (ms_per_brick_64 and every row)");

@@ -76,8 +76,7 @@ void checkAgainstOracle(std::uint32_t brickSize, std::uint32_t overlap, double f
         ASSERT_EQ(converted.isSet(cell), expected.set) << "cell " << x << "," << y << "," << z;
         expectedSet += expected.set;
         if (expected.set && reduction != AttributeReduction::None) {
-          ASSERT_EQ(converted.attribute(cell),
-                    reduction == AttributeReduction::Mean ? expected.mean : expected.max)
+          ASSERT_EQ(converted.attribute(cell), reduction == AttributeReduction::Mean ? expected.mean : expected.max)
               << "cell " << x << "," << y << "," << z;
         }
       }
@@ -94,7 +93,8 @@ void checkAgainstOracle(std::uint32_t brickSize, std::uint32_t overlap, double f
 }
 
 TEST(ConvertBrick, MatchesOracle32) {
-  for (std::uint32_t overlap : {0u, 1u, 3u, 8u}) checkAgainstOracle(32, overlap, 0.15, AttributeReduction::None, overlap);
+  for (std::uint32_t overlap : {0u, 1u, 3u, 8u})
+    checkAgainstOracle(32, overlap, 0.15, AttributeReduction::None, overlap);
 }
 
 TEST(ConvertBrick, MatchesOracleWithMeanAttributes) {

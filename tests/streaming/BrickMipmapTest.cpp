@@ -9,7 +9,8 @@
 namespace flipscope {
 namespace {
 
-void checkMipmap(std::uint32_t brickSize, std::uint32_t overlap, std::uint32_t dilation, double fill, std::uint32_t seed) {
+void checkMipmap(std::uint32_t brickSize, std::uint32_t overlap, std::uint32_t dilation, double fill,
+                 std::uint32_t seed) {
   std::mt19937 rng(seed);
   std::array<DecodedBrick, 27> storage;
   Neighbourhood<DecodedBrick> bricks{};

@@ -27,15 +27,15 @@ class StoreBrickSourceTest : public ::testing::Test {
     header.attribute = AttributeKind::Speed;
     BrickStore store = BrickStore::createOrAppend(mDir, header);
     std::vector<glm::uvec3> coords = mSynthetic.bricks(1);
-    std::sort(coords.begin(), coords.end(), [](glm::uvec3 a, glm::uvec3 b) {
-      return mortonEncode3(a.x, a.y, a.z) < mortonEncode3(b.x, b.y, b.z);
-    });
+    std::sort(coords.begin(), coords.end(),
+              [](glm::uvec3 a, glm::uvec3 b) { return mortonEncode3(a.x, a.y, a.z) < mortonEncode3(b.x, b.y, b.z); });
     FrameWriter writer(store.framePath(1), header, 1);
     FrameStats stats;
     for (glm::uvec3 c : coords) {
       auto brick = mSynthetic.read({1, c});
       if (!brick) continue;
-      writer.addBrick(c, std::uint32_t(brick->particleCount()), std::uint32_t(brick->cells.size()), encodeBrick(*brick, 1));
+      writer.addBrick(c, std::uint32_t(brick->particleCount()), std::uint32_t(brick->cells.size()),
+                      encodeBrick(*brick, 1));
       stats.particles += brick->particleCount();
     }
     writer.finish(stats);
@@ -62,7 +62,7 @@ TEST_F(StoreBrickSourceTest, ReadsWhatWasWritten) {
         EXPECT_EQ(read->counts, expected->counts);
         EXPECT_EQ(read->attributes, expected->attributes);
       }
-  EXPECT_EQ(source.read({0, {0, 0, 0}}), nullptr);           // no such frame
+  EXPECT_EQ(source.read({0, {0, 0, 0}}), nullptr);            // no such frame
   EXPECT_EQ(source.read({1, {0xffffffffu, 0, 0}}), nullptr);  // outside the grid
 }
 
