@@ -41,6 +41,15 @@ void AtomicFile::write(const void* data, std::size_t bytes) {
   mOffset += bytes;
 }
 
+void AtomicFile::writeAt(std::uint64_t offset, const void* data, std::size_t bytes) {
+  FLIPSCOPE_CHECK(mFile, "write after commit");
+  FLIPSCOPE_CHECK(offset + bytes <= mOffset, "offset=" << offset << " bytes=" << bytes << " written=" << mOffset);
+  if (::fseeko(mFile, static_cast<off_t>(offset), SEEK_SET) != 0 ||
+      (bytes && std::fwrite(data, 1, bytes, mFile) != bytes) ||
+      ::fseeko(mFile, static_cast<off_t>(mOffset), SEEK_SET) != 0)
+    throw FileError(mTemporary, "write at byte " + std::to_string(offset) + " failed: " + errnoText());
+}
+
 void AtomicFile::commit() {
   FLIPSCOPE_CHECK(mFile, "commit twice");
   if (std::fflush(mFile) != 0) throw FileError(mTemporary, "flush failed: " + errnoText());

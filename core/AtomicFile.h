@@ -23,6 +23,9 @@ class AtomicFile {
 
   void write(const void* data, std::size_t bytes);
   void write(std::span<const std::byte> bytes) { write(bytes.data(), bytes.size()); }
+  /// Overwrites `bytes` bytes at `offset` (already written: offset + bytes <= offset()), e.g. a
+  /// header field known only at the end; later writes append again.
+  void writeAt(std::uint64_t offset, const void* data, std::size_t bytes);
   /// Bytes written so far.
   std::uint64_t offset() const { return mOffset; }
   /// Flushes, fsyncs, renames over the destination and fsyncs the directory. Throws FileError.

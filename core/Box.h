@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <limits>
 
+#include <glm/common.hpp>
 #include <glm/vec3.hpp>
 
 namespace flipscope {

@@ -1,13 +1,98 @@
+// flipscope convert: particle caches -> brick store (preprocess/Convert.h).
 #include <CLI/CLI.hpp>
 
+#include <cstdio>
+#include <memory>
+
 #include "core/Error.h"
+#include "preprocess/Convert.h"
+#include "preprocess/InputSequence.h"
+#include "tools/CliValues.h"
 #include "tools/Commands.h"
 
 namespace flipscope::tools {
+namespace {
+
+struct ConvertArgs {
+  std::vector<std::string> inputs;
+  std::string store;
+  std::string frames;
+  std::vector<std::string> grids;
+  double cellSize = 0;
+  std::uint32_t resolution = 1024;
+  std::uint32_t brickSize = 64;
+  std::string domain;
+  std::string mem = "4G";
+  std::string attribute = "auto";
+  int zstdLevel = 1;
+  std::string scratch;
+  bool quiet = false;
+};
+
+void runConvert(const ConvertArgs& a) {
+  ConvertOptions options;
+  if (a.cellSize != 0) options.cellSize = a.cellSize;
+  options.resolution = a.resolution;
+  options.brickSize = a.brickSize;
+  if (!a.domain.empty()) options.domain = parseBox("--domain", a.domain);
+  options.memoryBudget = parseBytes("--mem", a.mem);
+  if (a.attribute == "speed") options.attribute = true;
+  else if (a.attribute == "none") options.attribute = false;
+  options.zstdLevel = a.zstdLevel;
+  options.scratchDir = a.scratch;
+  options.read.grids = a.grids;
+  options.read.velocity = a.attribute != "none";
+  options.progress = a.quiet ? Progress::Mode::Silent : Progress::Mode::Auto;
+
+  std::optional<FrameRange> range;
+  if (!a.frames.empty()) range = parseFrameRange(a.frames);
+  const auto inputs = expandInputs(a.inputs, range);
+  const ConvertReport report = convert(inputs, a.store, options);
+
+  if (a.quiet) return;
+  const StoreHeader& h = report.header;
+  std::printf("store %s: cell size %g, bricks of %u^3, grid %ux%ux%u bricks, attribute %s\n", a.store.c_str(),
+              h.cellSize, h.brickSize, h.brickGrid.x, h.brickGrid.y, h.brickGrid.z, attributeName(h.attribute));
+  for (const auto& f : report.frames) {
+    std::printf("  frame %d: %llu particles, %u bricks, %s bytes, %.2f s%s", f.frame,
+                (unsigned long long)f.stats.particles, f.bricks, Progress::humanCount(double(f.storeBytes)).c_str(),
+                f.seconds, f.spillBuckets ? " (out of core)" : "");
+    if (f.stats.skippedInvalid || f.stats.skippedOutside)
+      std::printf("; skipped %llu NaN/Inf and %llu outside the domain", (unsigned long long)f.stats.skippedInvalid,
+                  (unsigned long long)f.stats.skippedOutside);
+    std::printf("\n");
+  }
+}
+
+}  // namespace
 
 void addConvertCommand(CLI::App& app) {
-  auto* cmd = app.add_subcommand("convert", "(not yet implemented)");
-  cmd->callback([] { throw InputError("convert: not yet implemented"); });
+  auto args = std::make_shared<ConvertArgs>();
+  auto* cmd = app.add_subcommand("convert", "Bin particle caches (.vdb, .ply, .bin/.raw, sequences) into a brick store");
+  cmd->add_option("inputs", args->inputs,
+                  "Input files or patterns (name_####.vdb, %04d, {}); several per frame merge into one frame")
+      ->required();
+  cmd->add_option("-o,--output", args->store, "Brick store directory (created, or appended to)")->required();
+  cmd->add_option("--frames", args->frames, "Frame range A-B for patterns (default: every frame found)");
+  cmd->add_option("--grid", args->grids, "VDB: PointDataGrid names to read (default: all)");
+  auto* cell = cmd->add_option("--cell-size", args->cellSize, "Cell size in world units")->check(CLI::PositiveNumber);
+  cmd->add_option("--resolution", args->resolution, "Cells along the longest domain axis (if no --cell-size)")
+      ->excludes(cell)
+      ->capture_default_str();
+  cmd->add_option("--brick-size", args->brickSize, "Cells per brick edge")
+      ->check(CLI::IsMember({32, 64, 128}))
+      ->capture_default_str();
+  cmd->add_option("--domain", args->domain, "x0,y0,z0,x1,y1,z1 in world units (default: bounds of the data)");
+  cmd->add_option("--mem", args->mem, "Memory budget, e.g. 512M, 8G")->capture_default_str();
+  cmd->add_option("--attribute", args->attribute, "Per-particle attribute to store")
+      ->check(CLI::IsMember({"auto", "speed", "none"}))
+      ->capture_default_str();
+  cmd->add_option("--zstd-level", args->zstdLevel, "zstd level of brick payloads")
+      ->check(CLI::Range(-5, 19))
+      ->capture_default_str();
+  cmd->add_option("--scratch", args->scratch, "Directory for spill files (default: the store)");
+  cmd->add_flag("-q,--quiet", args->quiet, "No progress and no summary");
+  cmd->callback([args] { runConvert(*args); });
 }
 
 }  // namespace flipscope::tools

@@ -1,0 +1,239 @@
+// Binning of particle keys into encoded bricks (layout in BrickBinning.h).
+// Sorting: an MSD counting sort on the brick Morton code in 16-bit digits (one parallel pass
+// for the grids of practice, whose codes have at most 18 bits), then per brick either a cell
+// histogram (dense bricks) or a comparison sort (sparse bricks).
+#include "preprocess/BrickBinning.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+
+#include "core/Error.h"
+#include "core/Morton.h"
+
+namespace flipscope::detail {
+
+KeyGrid::KeyGrid(const StoreHeader& h, std::optional<Box> clipBox)
+    : header(h),
+      clip(clipBox),
+      invCellSize(1.0 / h.cellSize),
+      cells(glm::u64vec3(h.brickGrid) * std::uint64_t(h.brickSize)),
+      brickShift(std::uint32_t(std::countr_zero(h.brickSize))),
+      cellBits(3 * brickShift),
+      codeBits(3 * octreeLevelsFor(std::max({h.brickGrid.x, h.brickGrid.y, h.brickGrid.z}))) {
+  FLIPSCOPE_CHECK(cellBits + codeBits + 16 <= 64, "grid too large for 64-bit keys");
+}
+
+void computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, bool attribute, KeyBatch& out) {
+  const std::size_t n = chunk.size();
+  FLIPSCOPE_CHECK(!attribute || chunk.velocities.size() == n, "attribute needs velocities");
+  constexpr std::uint64_t kInvalid = ~0ull, kOutside = ~0ull - 1;
+  const std::size_t base = out.cellKeys.size();
+  out.cellKeys.resize(base + n);
+  std::uint64_t* keys = out.cellKeys.data() + base;
+  const std::uint32_t mask = grid.header.brickSize - 1;
+
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1 << 14), [&](const auto& range) {
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      const glm::vec3 p = chunk.positions[i];
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+        keys[i] = kInvalid;
+        continue;
+      }
+      const glm::dvec3 q(p);
+      if (grid.clip && !grid.clip->contains(q)) {
+        keys[i] = kOutside;
+        continue;
+      }
+      const glm::dvec3 c = glm::floor((q - grid.header.origin) * grid.invCellSize);
+      if (c.x < 0 || c.y < 0 || c.z < 0 || c.x >= double(grid.cells.x) || c.y >= double(grid.cells.y) ||
+          c.z >= double(grid.cells.z)) {
+        keys[i] = kOutside;
+        continue;
+      }
+      const glm::uvec3 cell(c);
+      const glm::uvec3 brick = cell >> grid.brickShift;
+      const glm::uvec3 local = cell & mask;
+      const std::uint64_t code = mortonEncode3(brick.x, brick.y, brick.z);
+      const std::uint64_t inBrick = local.x | (local.y << grid.brickShift) | (local.z << (2 * grid.brickShift));
+      keys[i] = (code << grid.cellBits) | inBrick;
+    }
+  });
+
+  // Compact in order (keeps the stream deterministic), counting what was skipped.
+  std::size_t kept = base;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint64_t k = keys[i];
+    if (k == kInvalid) {
+      ++out.invalid;
+    } else if (k == kOutside) {
+      ++out.outside;
+    } else {
+      if (attribute) {
+        const float s = glm::length(chunk.velocities[i]);
+        const float speed = std::isfinite(s) ? s : 0.0f;
+        if (kept == 0) out.speedMin = out.speedMax = speed;
+        out.speedMin = std::min(out.speedMin, speed);
+        out.speedMax = std::max(out.speedMax, speed);
+        out.speeds.push_back(speed);
+      }
+      out.cellKeys[kept++] = k;
+    }
+  }
+  out.cellKeys.resize(kept);
+}
+
+std::uint16_t quantizeAttribute(float s, float min, float max) {
+  if (!(max > min)) return 0;
+  const float t = (s - min) / (max - min);
+  return std::uint16_t(std::lround(std::clamp(t, 0.0f, 1.0f) * 65535.0f));
+}
+
+namespace {
+
+constexpr std::uint32_t kDigitBits = 16;
+constexpr std::size_t kParallelThreshold = 1 << 16;
+
+/// Stable counting sort of keys[begin,end) by the digit (key >> shift) & (2^bits - 1) into
+/// out[begin,end); returns the start offset of each digit value (size 2^bits + 1).
+std::vector<std::size_t> countingSort(const std::uint64_t* in, std::uint64_t* out, std::size_t n, std::uint32_t shift,
+                                      std::uint32_t bits) {
+  const std::size_t buckets = std::size_t(1) << bits;
+  const std::uint64_t mask = buckets - 1;
+  const std::size_t blocks = n >= kParallelThreshold ? 8 : 1;
+  const std::size_t blockSize = (n + blocks - 1) / blocks;
+  std::vector<std::vector<std::size_t>> histograms(blocks, std::vector<std::size_t>(buckets, 0));
+  tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
+    auto& h = histograms[b];
+    const std::size_t e = std::min(n, (b + 1) * blockSize);
+    for (std::size_t i = b * blockSize; i < e; ++i) ++h[(in[i] >> shift) & mask];
+  });
+  std::vector<std::size_t> starts(buckets + 1, 0);
+  std::size_t offset = 0;
+  for (std::size_t d = 0; d < buckets; ++d) {
+    starts[d] = offset;
+    for (std::size_t b = 0; b < blocks; ++b) {
+      const std::size_t count = histograms[b][d];
+      histograms[b][d] = offset;
+      offset += count;
+    }
+  }
+  starts[buckets] = offset;
+  tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
+    auto& h = histograms[b];
+    const std::size_t e = std::min(n, (b + 1) * blockSize);
+    for (std::size_t i = b * blockSize; i < e; ++i) out[h[(in[i] >> shift) & mask]++] = in[i];
+  });
+  return starts;
+}
+
+struct BrickRun {
+  std::size_t begin, end;  // in the array that holds the run after sorting
+  bool inScratch;
+};
+
+/// MSD counting sort by brick code; appends one run per brick in ascending code order.
+void splitByBrick(std::uint64_t* keys, std::uint64_t* scratch, std::size_t begin, std::size_t end,
+                  std::uint32_t lowBit, std::uint32_t highBit, bool inScratch, std::vector<BrickRun>& runs) {
+  if (begin == end) return;
+  if (highBit <= lowBit) {
+    runs.push_back({begin, end, inScratch});
+    return;
+  }
+  const std::uint64_t* src = (inScratch ? scratch : keys) + begin;
+  std::uint64_t* dst = (inScratch ? keys : scratch) + begin;
+  const std::uint32_t bits = std::min(kDigitBits, highBit - lowBit);
+  const std::uint32_t shift = highBit - bits;
+  // Fast path: every key has the same digit.
+  const std::uint64_t first = (src[0] >> shift) & ((1ull << bits) - 1);
+  bool uniform = true;
+  for (std::size_t i = 1; i < end - begin && uniform; ++i) uniform = ((src[i] >> shift) & ((1ull << bits) - 1)) == first;
+  if (uniform) return splitByBrick(keys, scratch, begin, end, lowBit, shift, inScratch, runs);
+  auto starts = countingSort(src, dst, end - begin, shift, bits);
+  for (std::size_t d = 0; d + 1 < starts.size(); ++d)
+    if (starts[d] != starts[d + 1])
+      splitByBrick(keys, scratch, begin + starts[d], begin + starts[d + 1], lowBit, shift, !inScratch, runs);
+}
+
+/// Encodes one brick's keys (same brick code, any order) into `out` (reuses its vectors).
+void decodeRun(std::span<std::uint64_t> keys, const KeyGrid& grid, bool attribute, DecodedBrick& out,
+               std::vector<std::uint32_t>& histogram) {
+  out.cells.clear();
+  out.counts.clear();
+  out.attributes.clear();
+  const std::uint32_t cellsPerBrick = grid.header.cellsPerBrick();
+  const std::uint64_t cellMask = (1ull << grid.cellBits) - 1;
+  auto cellOf = [&](std::uint64_t key) { return std::uint32_t((key >> 16) & cellMask); };
+  if (keys.size() * 16 < cellsPerBrick) {
+    // Sparse: sort (cell, attribute) directly.
+    std::sort(keys.begin(), keys.end());
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+      const std::uint32_t cell = cellOf(keys[i]);
+      if (out.cells.empty() || out.cells.back() != cell) {
+        out.cells.push_back(cell);
+        out.counts.push_back(0);
+      }
+      ++out.counts.back();
+      if (attribute) out.attributes.push_back(std::uint16_t(keys[i] & 0xffff));
+    }
+    return;
+  }
+  // Dense: histogram over the brick's cells.
+  histogram.assign(cellsPerBrick, 0);
+  for (auto k : keys) ++histogram[cellOf(k)];
+  std::uint32_t offset = 0;
+  for (std::uint32_t c = 0; c < cellsPerBrick; ++c) {
+    if (!histogram[c]) continue;
+    out.cells.push_back(c);
+    out.counts.push_back(histogram[c]);
+    const std::uint32_t count = histogram[c];
+    histogram[c] = offset;  // becomes the cell's first attribute slot
+    offset += count;
+  }
+  if (!attribute) return;
+  out.attributes.resize(keys.size());
+  for (auto k : keys) out.attributes[histogram[cellOf(k)]++] = std::uint16_t(k & 0xffff);
+  std::size_t start = 0;
+  for (auto count : out.counts) {
+    std::sort(out.attributes.begin() + start, out.attributes.begin() + start + count);
+    start += count;
+  }
+}
+
+}  // namespace
+
+void binKeys(std::vector<std::uint64_t>& keys, std::vector<std::uint64_t>& scratch, const KeyGrid& grid, bool attribute,
+             int zstdLevel, const std::function<void(EncodedBrick&&)>& sink) {
+  if (keys.empty()) return;
+  scratch.resize(keys.size());
+  std::vector<BrickRun> runs;
+  const std::uint32_t lowBit = 16 + grid.cellBits;
+  splitByBrick(keys.data(), scratch.data(), 0, keys.size(), lowBit, lowBit + grid.codeBits, false, runs);
+
+  constexpr std::size_t kBatch = 64;
+  std::vector<EncodedBrick> batch;
+  for (std::size_t first = 0; first < runs.size(); first += kBatch) {
+    const std::size_t count = std::min(kBatch, runs.size() - first);
+    batch.assign(count, {});
+    tbb::parallel_for(std::size_t(0), count, [&](std::size_t i) {
+      const BrickRun& run = runs[first + i];
+      std::span<std::uint64_t> span((run.inScratch ? scratch : keys).data() + run.begin, run.end - run.begin);
+      thread_local DecodedBrick brick;
+      thread_local std::vector<std::uint32_t> histogram;
+      decodeRun(span, grid, attribute, brick, histogram);
+      EncodedBrick& e = batch[i];
+      e.coord = glm::uvec3(mortonDecode3(std::uint32_t(span[0] >> lowBit)));
+      e.particles = std::uint32_t(span.size());
+      e.cells = std::uint32_t(brick.cells.size());
+      e.payload = encodeBrick(brick, zstdLevel);
+    });
+    for (auto& e : batch) sink(std::move(e));
+  }
+}
+
+}  // namespace flipscope::detail

@@ -1,0 +1,399 @@
+// convert(): particle files -> BrickStore, in core or out of core (see Convert.h).
+#include "preprocess/Convert.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+
+#include "core/Error.h"
+#include "preprocess/BrickBinning.h"
+#include "preprocess/FrameFile.h"
+
+namespace flipscope {
+namespace {
+
+using detail::KeyBatch;
+using detail::KeyGrid;
+
+constexpr std::size_t kSpillBufferBytes = 64 << 10;
+
+/// Memory plan of one conversion, all derived from the budget.
+struct MemoryPlan {
+  explicit MemoryPlan(std::uint64_t budget, bool attribute) {
+    const std::uint64_t perParticle = attribute ? 20 : 16;  // key + scratch (+ speed)
+    chunkParticles = std::clamp<std::uint64_t>(budget / 256 / 24, 4096, 1 << 20);
+    maxBinParticles = std::max<std::uint64_t>(budget * 6 / 10 / perParticle, 1 << 16);
+    maxBucketFiles = std::clamp<std::uint64_t>(budget / 8 / kSpillBufferBytes, 2, 256);
+  }
+  std::uint64_t chunkParticles;   ///< particles read at once
+  std::uint64_t maxBinParticles;  ///< particles binned in memory at once
+  std::uint64_t maxBucketFiles;   ///< spill files open at once
+};
+
+/// Spill record: 48-bit cell key, then the speed when the store has an attribute.
+std::size_t recordBytes(bool attribute) { return attribute ? 12 : 8; }
+
+/// Bucket files of one partition level: bucket b holds the keys whose digit
+/// (cellKey >> shift) & (count - 1) is b. Files are removed on destruction.
+class SpillBuckets {
+ public:
+  SpillBuckets(const std::filesystem::path& dir, const std::string& prefix, std::uint32_t shift, std::uint32_t bits,
+               bool attribute)
+      : mShift(shift), mBits(bits), mAttribute(attribute) {
+    const std::size_t count = std::size_t(1) << bits;
+    for (std::size_t b = 0; b < count; ++b) {
+      Bucket bucket;
+      bucket.path = dir / (prefix + "-" + std::to_string(b));
+      mBuckets.push_back(std::move(bucket));
+    }
+  }
+  ~SpillBuckets() {
+    for (auto& b : mBuckets) {
+      if (b.file) std::fclose(b.file);
+      std::error_code ec;
+      std::filesystem::remove(b.path, ec);
+    }
+  }
+  SpillBuckets(const SpillBuckets&) = delete;
+  SpillBuckets& operator=(const SpillBuckets&) = delete;
+
+  void add(const std::uint64_t* keys, const float* speeds, std::size_t n) {
+    const std::uint64_t mask = (1ull << mBits) - 1;
+    for (std::size_t i = 0; i < n; ++i) {
+      Bucket& b = mBuckets[(keys[i] >> mShift) & mask];
+      auto* p = reinterpret_cast<const std::byte*>(&keys[i]);
+      b.buffer.insert(b.buffer.end(), p, p + 8);
+      if (mAttribute) {
+        auto* s = reinterpret_cast<const std::byte*>(&speeds[i]);
+        b.buffer.insert(b.buffer.end(), s, s + 4);
+      }
+      ++b.records;
+      if (b.buffer.size() >= kSpillBufferBytes) flush(b);
+    }
+  }
+  void finish() {
+    for (auto& b : mBuckets) {
+      flush(b);
+      if (b.file) {
+        std::fclose(b.file);
+        b.file = nullptr;
+      }
+      std::vector<std::byte>().swap(b.buffer);
+    }
+  }
+  std::size_t size() const { return mBuckets.size(); }
+  std::uint64_t records(std::size_t b) const { return mBuckets[b].records; }
+  std::uint32_t shift() const { return mShift; }
+
+  /// Streams bucket b (after finish()) in pieces of at most 8192 records:
+  /// fn(const uint64_t* keys, const float* speeds, size_t n); speeds is null without attribute.
+  template <class Fn>
+  void forEachPiece(std::size_t b, Fn&& fn) const {
+    const Bucket& bucket = mBuckets[b];
+    if (!bucket.records) return;
+    std::FILE* f = std::fopen(bucket.path.c_str(), "rb");
+    if (!f) throw FileError(bucket.path, "cannot reopen spill file");
+    constexpr std::size_t kPiece = 8192;
+    const std::size_t bytes = recordBytes(mAttribute);
+    std::vector<std::byte> buffer(bytes * kPiece);
+    std::vector<std::uint64_t> keys(kPiece);
+    std::vector<float> speeds(mAttribute ? kPiece : 0);
+    for (std::uint64_t done = 0; done < bucket.records;) {
+      const std::size_t n = std::min<std::uint64_t>(kPiece, bucket.records - done);
+      if (std::fread(buffer.data(), bytes, n, f) != n) {
+        std::fclose(f);
+        throw FileError(bucket.path, "spill file shorter than written");
+      }
+      for (std::size_t i = 0; i < n; ++i) {
+        std::memcpy(&keys[i], buffer.data() + i * bytes, 8);
+        if (mAttribute) std::memcpy(&speeds[i], buffer.data() + i * bytes + 8, 4);
+      }
+      fn(keys.data(), mAttribute ? speeds.data() : nullptr, n);
+      done += n;
+    }
+    std::fclose(f);
+  }
+
+  /// Loads bucket b (after finish()) into keys/speeds.
+  void load(std::size_t b, std::vector<std::uint64_t>& keys, std::vector<float>& speeds) const {
+    keys.clear();
+    speeds.clear();
+    keys.reserve(mBuckets[b].records);
+    forEachPiece(b, [&](const std::uint64_t* k, const float* s, std::size_t n) {
+      keys.insert(keys.end(), k, k + n);
+      if (s) speeds.insert(speeds.end(), s, s + n);
+    });
+  }
+
+ private:
+  struct Bucket {
+    std::filesystem::path path;
+    std::FILE* file = nullptr;
+    std::vector<std::byte> buffer;
+    std::uint64_t records = 0;
+  };
+  void flush(Bucket& b) {
+    if (b.buffer.empty()) return;
+    if (!b.file) {
+      b.file = std::fopen(b.path.c_str(), "wb");
+      if (!b.file) throw FileError(b.path, std::string("cannot create spill file: ") + std::strerror(errno));
+    }
+    if (std::fwrite(b.buffer.data(), 1, b.buffer.size(), b.file) != b.buffer.size())
+      throw FileError(b.path, std::string("spill write failed (disk full?): ") + std::strerror(errno));
+    b.buffer.clear();
+  }
+
+  std::uint32_t mShift, mBits;
+  bool mAttribute;
+  std::vector<Bucket> mBuckets;
+};
+
+/// Bins one frame's keys: in memory while they fit, spilled to buckets beyond.
+class FrameBinner {
+ public:
+  FrameBinner(const KeyGrid& grid, bool attribute, const MemoryPlan& plan, const ConvertOptions& options,
+              std::filesystem::path scratchDir, int frame)
+      : mGrid(grid), mAttribute(attribute), mPlan(plan), mOptions(options), mScratch(std::move(scratchDir)),
+        mPrefix(".spill-" + std::to_string(::getpid()) + "-" + std::to_string(frame)) {}
+
+  void add(KeyBatch& batch) {
+    mStats.skippedInvalid += batch.invalid;
+    mStats.skippedOutside += batch.outside;
+    if (!batch.cellKeys.empty()) {
+      if (!mHasSpeed) {
+        mStats.attributeMin = batch.speedMin;
+        mStats.attributeMax = batch.speedMax;
+        mHasSpeed = true;
+      }
+      mStats.attributeMin = std::min(mStats.attributeMin, batch.speedMin);
+      mStats.attributeMax = std::max(mStats.attributeMax, batch.speedMax);
+    }
+    if (mSpill) {
+      mSpill->add(batch.cellKeys.data(), batch.speeds.data(), batch.cellKeys.size());
+      return;
+    }
+    if (mKeys.capacity() == 0) {  // reserve address space once: no reallocation copies, pages touched as used
+      mKeys.reserve(mPlan.maxBinParticles + mPlan.chunkParticles);
+      if (mAttribute) mSpeeds.reserve(mPlan.maxBinParticles + mPlan.chunkParticles);
+    }
+    mKeys.insert(mKeys.end(), batch.cellKeys.begin(), batch.cellKeys.end());
+    mSpeeds.insert(mSpeeds.end(), batch.speeds.begin(), batch.speeds.end());
+    if (mKeys.size() > mPlan.maxBinParticles) startSpilling();
+  }
+
+  /// Bins everything added into `writer`; returns the frame's stats.
+  FrameStats finish(FrameWriter& writer) {
+    if (!mAttribute) mStats.attributeMin = mStats.attributeMax = 0;
+    if (!mSpill) {
+      binInMemory(mKeys, mSpeeds, writer);
+    } else {
+      mSpill->finish();
+      binBuckets(*mSpill, writer);
+    }
+    return mStats;
+  }
+  std::uint32_t spillBuckets() const { return mSpillBuckets; }
+
+ private:
+  std::uint32_t bucketBitsFor(std::uint32_t availableBits) const {
+    std::uint32_t bits = 1;
+    while (bits < availableBits && (2ull << bits) <= mPlan.maxBucketFiles) ++bits;
+    return std::min(bits, availableBits);
+  }
+
+  void startSpilling() {
+    const std::uint32_t bits = bucketBitsFor(mGrid.codeBits);
+    mSpill = std::make_unique<SpillBuckets>(mScratch, mPrefix, mGrid.cellBits + mGrid.codeBits - bits, bits, mAttribute);
+    mSpill->add(mKeys.data(), mSpeeds.data(), mKeys.size());
+    std::vector<std::uint64_t>().swap(mKeys);
+    std::vector<float>().swap(mSpeeds);
+    mSpillBuckets += std::uint32_t(mSpill->size());
+  }
+
+  void binBuckets(const SpillBuckets& buckets, FrameWriter& writer) {
+    std::vector<std::uint64_t> keys;
+    std::vector<float> speeds;
+    for (std::size_t b = 0; b < buckets.size(); ++b) {
+      if (buckets.records(b) == 0) continue;
+      if (buckets.records(b) <= mPlan.maxBinParticles) {
+        buckets.load(b, keys, speeds);
+        binInMemory(keys, speeds, writer);
+        continue;
+      }
+      // Skewed data: split this bucket by the next bits of the brick code.
+      const std::uint32_t remaining = buckets.shift() - mGrid.cellBits;
+      if (remaining == 0)
+        throw InputError("a single brick holds " + std::to_string(buckets.records(b)) +
+                         " particles, more than --mem allows binning at once; raise --mem or use a smaller cell size");
+      const std::uint32_t bits = bucketBitsFor(remaining);
+      SpillBuckets sub(mScratch, mPrefix + "-" + std::to_string(mSpillBuckets), buckets.shift() - bits, bits, mAttribute);
+      mSpillBuckets += std::uint32_t(sub.size());
+      buckets.forEachPiece(b, [&](const std::uint64_t* k, const float* s, std::size_t n) { sub.add(k, s, n); });
+      sub.finish();
+      binBuckets(sub, writer);
+    }
+  }
+
+  void binInMemory(std::vector<std::uint64_t>& keys, std::vector<float>& speeds, FrameWriter& writer) {
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+      const std::uint16_t a =
+          mAttribute ? detail::quantizeAttribute(speeds[i], mStats.attributeMin, mStats.attributeMax) : 0;
+      keys[i] = (keys[i] << 16) | a;
+    }
+    std::vector<float>().swap(speeds);
+    std::vector<std::uint64_t> scratch;
+    detail::binKeys(keys, scratch, mGrid, mAttribute, mOptions.zstdLevel, [&](detail::EncodedBrick&& brick) {
+      writer.addBrick(brick.coord, brick.particles, brick.cells, brick.payload);
+      mStats.particles += brick.particles;
+    });
+    std::vector<std::uint64_t>().swap(keys);
+  }
+
+  const KeyGrid& mGrid;
+  bool mAttribute;
+  MemoryPlan mPlan;
+  const ConvertOptions& mOptions;
+  std::filesystem::path mScratch;
+  std::string mPrefix;
+  FrameStats mStats;
+  bool mHasSpeed = false;
+  std::vector<std::uint64_t> mKeys;
+  std::vector<float> mSpeeds;
+  std::unique_ptr<SpillBuckets> mSpill;
+  std::uint32_t mSpillBuckets = 0;
+};
+
+std::unique_ptr<ParticleSource> openFrame(const FrameInput& input, const ReadOptions& read) {
+  std::vector<std::unique_ptr<ParticleSource>> parts;
+  for (const auto& file : input.files) parts.push_back(openParticleFile(file, read));
+  if (parts.size() == 1) return std::move(parts.front());
+  return concatSources(std::move(parts));
+}
+
+Box scanBounds(ParticleSource& source, std::size_t chunkParticles, Progress* progress) {
+  Box bounds;
+  ParticleChunk chunk;
+  while (source.read(chunk, chunkParticles)) {
+    for (const auto& p : chunk.positions)
+      if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) bounds.extend(glm::dvec3(p));
+    if (progress) progress->advance(chunk.size());
+  }
+  source.rewind();
+  return bounds;
+}
+
+}  // namespace
+
+StoreHeader makeStoreHeader(const Box& bounds, const ConvertOptions& options, bool attribute) {
+  if (options.brickSize != 32 && options.brickSize != 64 && options.brickSize != 128)
+    throw InputError("brick size must be 32, 64 or 128, not " + std::to_string(options.brickSize));
+  if (bounds.isEmpty()) throw InputError("no finite particle positions: cannot derive a domain (give --domain)");
+  const glm::dvec3 extent = bounds.extent();
+  const double longest = std::max({extent.x, extent.y, extent.z});
+  double cellSize = 0;
+  if (options.cellSize) {
+    cellSize = *options.cellSize;
+  } else {
+    if (options.resolution == 0) throw InputError("resolution must be positive");
+    cellSize = longest > 0 ? longest / options.resolution : 1.0;
+  }
+  if (!(std::isfinite(cellSize) && cellSize > 0)) throw InputError("cell size must be a positive number");
+  StoreHeader h;
+  h.brickSize = options.brickSize;
+  h.cellSize = cellSize;
+  h.origin = bounds.min;
+  h.attribute = attribute ? AttributeKind::Speed : AttributeKind::None;
+  for (int a = 0; a < 3; ++a) {
+    const double cells = std::floor(extent[a] / cellSize) + 1;  // the max corner lands in the last cell
+    if (cells > kMaxCellsPerAxis)
+      throw InputError("the domain is " + std::to_string(std::uint64_t(cells)) + " cells long on axis " + "xyz"[a] +
+                       ", more than " + std::to_string(kMaxCellsPerAxis) + "; use a larger --cell-size");
+    h.brickGrid[a] = std::uint32_t((std::uint64_t(cells) + h.brickSize - 1) / h.brickSize);
+  }
+  return h;
+}
+
+FrameReport convertFrame(ParticleSource& source, BrickStore& store, int frame, const ConvertOptions& options,
+                         Progress* progress) {
+  const auto start = std::chrono::steady_clock::now();
+  const StoreHeader& header = store.header();
+  const bool attribute = header.attribute != AttributeKind::None;
+  if (attribute && !source.hasVelocity())
+    throw FileError(source.name(), "has no velocities, but the store keeps a speed attribute");
+  const KeyGrid grid(header, options.domain);
+  const MemoryPlan plan(options.memoryBudget, attribute);
+  const std::filesystem::path scratch = options.scratchDir.empty() ? store.directory() : options.scratchDir;
+
+  FrameBinner binner(grid, attribute, plan, options, scratch, frame);
+  ParticleChunk chunk;
+  KeyBatch batch;
+  while (source.read(chunk, plan.chunkParticles)) {
+    batch.clear();
+    detail::computeKeys(chunk, grid, attribute, batch);
+    binner.add(batch);
+    if (progress) progress->advance(chunk.size());
+  }
+  FrameWriter writer(store.framePath(frame), header, frame);
+  FrameReport report;
+  report.frame = frame;
+  report.stats = binner.finish(writer);
+  FrameIndex index = writer.finish(report.stats);
+  store.addFrame(frame);
+  report.bricks = std::uint32_t(index.bricks.size());
+  report.storeBytes = index.fileBytes;
+  report.spillBuckets = binner.spillBuckets();
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return report;
+}
+
+ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesystem::path& storeDir,
+                      const ConvertOptions& options) {
+  if (inputs.empty()) throw InputError("convert: no input frames");
+  // Open every frame once to learn velocities and counts (headers only).
+  bool allVelocity = true;
+  std::uint64_t hinted = 0;
+  for (const auto& input : inputs) {
+    auto source = openFrame(input, options.read);
+    allVelocity = allVelocity && source->hasVelocity();
+    hinted += source->countHint().value_or(0);
+  }
+  const bool wantAttribute = options.attribute.value_or(allVelocity);
+  if (wantAttribute && !allVelocity) throw InputError("--attribute speed needs velocities in every input file");
+
+  StoreHeader header;
+  if (BrickStore::exists(storeDir)) {
+    header = BrickStore::open(storeDir).header();
+  } else if (options.domain) {
+    header = makeStoreHeader(*options.domain, options, wantAttribute);
+  } else {
+    Progress progress("scan bounds", hinted, "particles", options.progress);
+    Box bounds;
+    const MemoryPlan plan(options.memoryBudget, false);
+    for (const auto& input : inputs) bounds.extend(scanBounds(*openFrame(input, options.read), plan.chunkParticles, &progress));
+    progress.finish();
+    header = makeStoreHeader(bounds, options, wantAttribute);
+  }
+  BrickStore store = BrickStore::createOrAppend(storeDir, header);
+
+  ConvertReport report;
+  report.header = store.header();
+  Progress progress("convert", hinted, "particles", options.progress);
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    progress.setLabel("convert frame " + std::to_string(inputs[i].frame) + " (" + std::to_string(i + 1) + "/" +
+                      std::to_string(inputs.size()) + ")");
+    auto source = openFrame(inputs[i], options.read);
+    report.frames.push_back(convertFrame(*source, store, inputs[i].frame, options, &progress));
+  }
+  progress.setLabel("convert");
+  std::uint64_t bricks = 0, bytes = 0;
+  for (const auto& f : report.frames) bricks += f.bricks, bytes += f.storeBytes;
+  progress.finish(", " + std::to_string(report.frames.size()) + " frames, " + std::to_string(bricks) + " bricks, " +
+                  Progress::humanCount(double(bytes)) + "B");
+  return report;
+}
+
+}  // namespace flipscope

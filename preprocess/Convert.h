@@ -1,0 +1,74 @@
+// convert(): the preprocess of Reichl et al. 2014 §3 (Fig. 2), "spatial particle binning,
+// which is the only required preprocess": particle files -> BrickStore.
+//
+// Per frame, particles are quantized to cells of `cellSize` (world units), binned into bricks
+// of brickSize^3 cells, and each brick's particles are stored contiguously (cells and counts,
+// plus an optional 16-bit speed attribute), zstd-compressed one brick at a time; a presence
+// octree over the non-empty bricks closes the frame (PresenceOctree.h).
+//
+// Out of core: memory stays within `memoryBudget` (plus a small constant) whatever the input
+// size. Keys that do not fit are spilled to bucket files by Morton range of their brick and
+// each bucket is binned on its own (recursively split when the data is skewed); the store is
+// byte-identical to an in-core conversion.
+//
+// Oddities are counted, reported (FrameStats) and skipped: NaN/Inf coordinates, particles
+// outside `domain`.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <vector>
+
+#include "core/Box.h"
+#include "core/Progress.h"
+#include "preprocess/BrickStore.h"
+#include "preprocess/InputSequence.h"
+#include "preprocess/ParticleSource.h"
+
+namespace flipscope {
+
+inline constexpr std::uint64_t kDefaultMemoryBudget = 4ull << 30;
+inline constexpr std::uint32_t kMaxCellsPerAxis = 65536;
+
+struct ConvertOptions {
+  std::optional<Box> domain;           ///< world units; default: bounds of all frames (an extra read pass)
+  std::optional<double> cellSize;      ///< world units; default: longest domain axis / resolution
+  std::uint32_t resolution = 1024;     ///< cells along the longest axis when cellSize is unset
+  std::uint32_t brickSize = 64;        ///< 32, 64 or 128
+  std::uint64_t memoryBudget = kDefaultMemoryBudget;  ///< bytes
+  std::optional<bool> attribute;       ///< store speed; default: when every input has velocities
+  int zstdLevel = 1;
+  std::filesystem::path scratchDir;    ///< spill files; default: the store directory
+  ReadOptions read;
+  Progress::Mode progress = Progress::Mode::Auto;
+};
+
+struct FrameReport {
+  int frame = 0;
+  FrameStats stats;
+  std::uint32_t bricks = 0;
+  std::uint64_t storeBytes = 0;
+  double seconds = 0;
+  std::uint32_t spillBuckets = 0;  ///< 0 when the frame was binned in core
+};
+
+struct ConvertReport {
+  StoreHeader header;
+  std::vector<FrameReport> frames;
+};
+
+/// Converts every frame of `inputs` into the store at `storeDir` (created, or appended to:
+/// then its domain and cell size are kept). Throws InputError/FileError.
+ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesystem::path& storeDir,
+                      const ConvertOptions& options = {});
+
+/// The store header for particles within `bounds`. Throws InputError when the grid would
+/// exceed kMaxCellsPerAxis cells or the cell size is not positive.
+StoreHeader makeStoreHeader(const Box& bounds, const ConvertOptions& options, bool attribute);
+
+/// Bins one frame read from `source` into `store` (lower-level step of convert()).
+FrameReport convertFrame(ParticleSource& source, BrickStore& store, int frame, const ConvertOptions& options,
+                         Progress* progress = nullptr);
+
+}  // namespace flipscope

@@ -1,0 +1,76 @@
+// Raw particle files: little-endian float32 x y z, 12 bytes a particle, no header; the count
+// follows from the file size. Positions only.
+#include <algorithm>
+#include <bit>
+
+#include "core/AtomicFile.h"
+#include "core/Error.h"
+#include "preprocess/InputFile.h"
+#include "preprocess/ParticleFormats.h"
+
+namespace flipscope::detail {
+namespace {
+
+static_assert(sizeof(glm::vec3) == 12 && std::endian::native == std::endian::little,
+              "raw files are read straight into glm::vec3");
+constexpr std::uint64_t kRawParticleBytes = 12;
+
+class RawReader final : public ParticleSource {
+ public:
+  explicit RawReader(const std::filesystem::path& path) : mFile(path) {
+    if (mFile.size() % kRawParticleBytes != 0)
+      throw FileError(path, "raw particle file size " + std::to_string(mFile.size()) +
+                                " bytes is not a multiple of 12 (float32 x y z)");
+    mCount = mFile.size() / kRawParticleBytes;
+  }
+  std::string name() const override { return mFile.path().string(); }
+  bool hasVelocity() const override { return false; }
+  std::optional<std::uint64_t> countHint() const override { return mCount; }
+  bool read(ParticleChunk& chunk, std::size_t maxParticles) override {
+    FLIPSCOPE_CHECK(maxParticles > 0);
+    chunk.clear();
+    std::uint64_t n = std::min<std::uint64_t>(maxParticles, mCount - mNext);
+    if (n == 0) return false;
+    chunk.positions.resize(n);
+    std::size_t bytes = n * kRawParticleBytes;
+    if (mFile.read(chunk.positions.data(), bytes) != bytes)
+      throw FileError(mFile.path(), "file ends at byte " + std::to_string(mFile.offset()) + ", particle " +
+                                        std::to_string(mNext) + " of " + std::to_string(mCount) +
+                                        " (was it truncated while being read?)");
+    mNext += n;
+    return true;
+  }
+  void rewind() override {
+    mFile.seek(0);
+    mNext = 0;
+  }
+
+ private:
+  InputFile mFile;
+  std::uint64_t mCount = 0;
+  std::uint64_t mNext = 0;
+};
+
+class RawWriter final : public ParticleWriter {
+ public:
+  explicit RawWriter(const std::filesystem::path& path) : mFile(path) {}
+  void write(const ParticleChunk& chunk) override {
+    mFile.write(chunk.positions.data(), chunk.positions.size() * kRawParticleBytes);
+  }
+  void commit() override { mFile.commit(); }
+
+ private:
+  AtomicFile mFile;
+};
+
+}  // namespace
+
+std::unique_ptr<ParticleSource> openRawParticles(const std::filesystem::path& path) {
+  return std::make_unique<RawReader>(path);
+}
+
+std::unique_ptr<ParticleWriter> createRawWriter(const std::filesystem::path& path) {
+  return std::make_unique<RawWriter>(path);
+}
+
+}  // namespace flipscope::detail

@@ -1,0 +1,43 @@
+#include "preprocess/StoreInspection.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <mutex>
+
+#include "core/Error.h"
+
+namespace flipscope {
+
+FrameSummary summarizeFrame(const FrameIndex& frame, const StoreHeader& header) {
+  FrameSummary s;
+  s.frame = frame.frame;
+  s.particles = frame.stats.particles;
+  s.skippedInvalid = frame.stats.skippedInvalid;
+  s.skippedOutside = frame.stats.skippedOutside;
+  s.bricks = std::uint32_t(frame.bricks.size());
+  for (const auto& b : frame.bricks) s.occupiedCells += b.cells;
+  const double cells = double(s.bricks) * header.cellsPerBrick();
+  s.fillRate = cells > 0 ? double(s.occupiedCells) / cells : 0;
+  s.bitsPerParticle = s.particles ? cells / double(s.particles) : 0;
+  s.storeBytes = frame.fileBytes;
+  s.ratioToRaw = s.storeBytes ? 12.0 * double(s.particles) / double(s.storeBytes) : 0;
+  return s;
+}
+
+std::vector<std::string> verifyFrame(const BrickStore& store, const FrameIndex& frame) {
+  std::vector<std::string> errors;
+  std::mutex mutex;
+  tbb::parallel_for(std::size_t(0), frame.bricks.size(), [&](std::size_t i) {
+    try {
+      store.readBrick(frame, std::uint32_t(i));
+    } catch (const FileError& e) {
+      std::lock_guard lock(mutex);
+      errors.push_back(e.what());
+    }
+  });
+  std::sort(errors.begin(), errors.end());
+  return errors;
+}
+
+}  // namespace flipscope

@@ -1,0 +1,31 @@
+// What `flipscope info` reports about a BrickStore, as library calls.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "preprocess/BrickStore.h"
+
+namespace flipscope {
+
+struct FrameSummary {
+  int frame = 0;
+  std::uint64_t particles = 0;
+  std::uint64_t skippedInvalid = 0;
+  std::uint64_t skippedOutside = 0;
+  std::uint32_t bricks = 0;
+  std::uint64_t occupiedCells = 0;
+  double fillRate = 0;         ///< occupied cells / cells of the non-empty bricks
+  double bitsPerParticle = 0;  ///< bit-brick representation: bricks x cells per brick / particles (§4.1)
+  std::uint64_t storeBytes = 0;
+  double ratioToRaw = 0;       ///< raw float32 xyz bytes (12 per particle) / store bytes
+};
+
+FrameSummary summarizeFrame(const FrameIndex& frame, const StoreHeader& header);
+
+/// Reads every brick of `frame`, checks its checksum and decodes it. Returns one message per
+/// damaged brick (naming the file and the brick); empty when the frame is intact. Parallel.
+std::vector<std::string> verifyFrame(const BrickStore& store, const FrameIndex& frame);
+
+}  // namespace flipscope

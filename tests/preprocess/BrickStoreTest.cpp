@@ -1,0 +1,217 @@
+// Brick store format: codec round trips, header and frame file validation at every truncated
+// length and every single-byte corruption.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "core/AtomicFile.h"
+#include "core/Error.h"
+#include "preprocess/BrickStore.h"
+#include "preprocess/Convert.h"
+#include "VectorSource.h"
+
+namespace flipscope {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path freshDir(const std::string& name) {
+  fs::path dir = fs::temp_directory_path() / ("flipscope-test-" + name + "-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+DecodedBrick randomBrick(std::mt19937& rng, std::uint32_t cellsPerBrick, bool attribute) {
+  DecodedBrick b;
+  std::uint32_t cell = rng() % 100;
+  while (cell < cellsPerBrick && b.cells.size() < 3000) {
+    b.cells.push_back(cell);
+    b.counts.push_back(1 + rng() % 12);
+    cell += 1 + (rng() % 3 == 0 ? rng() % 2000 : rng() % 3);
+  }
+  if (attribute) {
+    for (auto c : b.counts) {
+      std::vector<std::uint16_t> a(c);
+      for (auto& v : a) v = std::uint16_t(rng());
+      std::sort(a.begin(), a.end());
+      b.attributes.insert(b.attributes.end(), a.begin(), a.end());
+    }
+  }
+  return b;
+}
+
+TEST(BrickCodec, RoundTripsRandomBricks) {
+  std::mt19937 rng(11);
+  for (int i = 0; i < 50; ++i) {
+    const bool attribute = i % 2;
+    DecodedBrick brick = randomBrick(rng, 64 * 64 * 64, attribute);
+    auto payload = encodeBrick(brick, 1);
+    BrickRecord r;
+    r.cells = std::uint32_t(brick.cells.size());
+    r.particles = std::uint32_t(brick.particleCount());
+    DecodedBrick back = decodeBrick(payload, "x.fsf", 3, r, 64 * 64 * 64, attribute);
+    EXPECT_EQ(back.cells, brick.cells);
+    EXPECT_EQ(back.counts, brick.counts);
+    EXPECT_EQ(back.attributes, brick.attributes);
+  }
+}
+
+TEST(BrickCodec, RejectsWrongCountsAndGarbage) {
+  std::mt19937 rng(5);
+  DecodedBrick brick = randomBrick(rng, 32 * 32 * 32, false);
+  auto payload = encodeBrick(brick, 1);
+  BrickRecord r;
+  r.cells = std::uint32_t(brick.cells.size());
+  r.particles = std::uint32_t(brick.particleCount()) + 1;
+  try {
+    decodeBrick(payload, "f.fsf", 9, r, 32 * 32 * 32, false);
+    FAIL() << "accepted a wrong particle count";
+  } catch (const FileError& e) {
+    EXPECT_NE(std::string(e.what()).find("f.fsf: brick 9"), std::string::npos) << e.what();
+  }
+  std::vector<std::byte> garbage(64, std::byte{0x5a});
+  EXPECT_THROW(decodeBrick(garbage, "f.fsf", 0, r, 32 * 32 * 32, false), FileError);
+}
+
+TEST(StoreHeader, RoundTripsAndRejectsEveryCorruption) {
+  StoreHeader h;
+  h.brickSize = 32;
+  h.cellSize = 0.125;
+  h.origin = {-1, 2, 3.5};
+  h.brickGrid = {4, 5, 6};
+  h.attribute = AttributeKind::Speed;
+  auto bytes = serializeStoreHeader(h);
+  StoreHeader back = parseStoreHeader(bytes, "store.fsh");
+  EXPECT_EQ(back.brickSize, h.brickSize);
+  EXPECT_EQ(back.cellSize, h.cellSize);
+  EXPECT_EQ(back.origin, h.origin);
+  EXPECT_EQ(back.brickGrid, h.brickGrid);
+  EXPECT_EQ(back.attribute, h.attribute);
+  for (std::size_t n = 0; n < bytes.size(); ++n)
+    EXPECT_THROW(parseStoreHeader(std::span(bytes).first(n), "store.fsh"), FileError) << "length " << n;
+  auto longer = bytes;
+  longer.push_back(std::byte{0});
+  EXPECT_THROW(parseStoreHeader(longer, "store.fsh"), FileError);
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    auto bad = bytes;
+    bad[i] ^= std::byte{0x41};
+    EXPECT_THROW(parseStoreHeader(bad, "store.fsh"), FileError) << "byte " << i;
+  }
+}
+
+TEST(StoreHeader, NamesAnUnknownVersion) {
+  StoreHeader h;
+  h.cellSize = 1;
+  h.brickGrid = {1, 1, 1};
+  h.version = 7;
+  auto bytes = serializeStoreHeader(h);
+  try {
+    parseStoreHeader(bytes, "s/store.fsh");
+    FAIL();
+  } catch (const FileError& e) {
+    EXPECT_NE(std::string(e.what()).find("unsupported store version 7"), std::string::npos) << e.what();
+  }
+}
+
+/// Plain write for damaged copies (no fsync: thousands of them per test).
+void writeBytes(const fs::path& file, std::span<const std::byte> bytes) {
+  std::ofstream out(file, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+}
+
+/// Reads a frame completely: index and every brick.
+void readWholeFrame(const fs::path& file, const StoreHeader& header, const BrickStore& store) {
+  FrameIndex index = readFrameIndex(file, header);
+  for (std::uint32_t i = 0; i < index.bricks.size(); ++i) store.readBrick(index, i);
+}
+
+class SmallStore : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir = freshDir("small");
+    ConvertOptions options;
+    options.cellSize = 0.25;
+    options.brickSize = 32;
+    options.progress = Progress::Mode::Silent;
+    auto positions = testing::randomParticles(600, 21, 20.0f);
+    std::vector<glm::vec3> velocities(positions.size());
+    for (std::size_t i = 0; i < velocities.size(); ++i) velocities[i] = {float(i % 7), 1, 0};
+    Box bounds{{0, 0, 0}, {20, 20, 20}};
+    BrickStore store = BrickStore::createOrAppend(dir, makeStoreHeader(bounds, options, true));
+    testing::VectorSource source(positions, velocities);
+    convertFrame(source, store, 4, options);
+  }
+  void TearDown() override { fs::remove_all(dir); }
+  fs::path dir;
+};
+
+TEST_F(SmallStore, EveryTruncatedLengthOfTheFrameFileIsRefused) {
+  BrickStore store = BrickStore::open(dir);
+  const fs::path file = store.framePath(4);
+  const auto bytes = readFile(file);
+  ASSERT_GT(bytes.size(), 200u);
+  readWholeFrame(file, store.header(), store);  // intact
+  const fs::path cut = dir / "frame_000005.fsf";
+  for (std::size_t n = 0; n < bytes.size(); ++n) {
+    writeBytes(cut, std::span(bytes).first(n));
+    EXPECT_THROW(readWholeFrame(cut, store.header(), store), FileError) << "length " << n;
+  }
+}
+
+TEST_F(SmallStore, EverySingleByteCorruptionOfTheFrameFileIsRefused) {
+  BrickStore store = BrickStore::open(dir);
+  const auto bytes = readFile(store.framePath(4));
+  const fs::path bad = dir / "frame_000006.fsf";
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    auto copy = bytes;
+    copy[i] ^= std::byte{0x10};
+    writeBytes(bad, copy);
+    EXPECT_THROW(readWholeFrame(bad, store.header(), store), FileError) << "byte " << i;
+  }
+}
+
+TEST_F(SmallStore, DamagedBrickIsNamedInTheError) {
+  BrickStore store = BrickStore::open(dir);
+  auto index = store.frame(4);
+  ASSERT_GT(index->bricks.size(), 2u);
+  auto bytes = readFile(store.framePath(4));
+  bytes[index->bricks[2].offset + 1] ^= std::byte{1};
+  writeFileAtomically(store.framePath(4), bytes);
+  BrickStore reopened = BrickStore::open(dir);
+  auto frame = reopened.frame(4);
+  EXPECT_NO_THROW(reopened.readBrick(*frame, 1));
+  try {
+    reopened.readBrick(*frame, 2);
+    FAIL();
+  } catch (const FileError& e) {
+    EXPECT_NE(std::string(e.what()).find("frame_000004.fsf: brick 2"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("checksum"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(SmallStore, AppendKeepsTheHeaderAndRefusesAnotherDomain) {
+  BrickStore store = BrickStore::open(dir);
+  StoreHeader other = store.header();
+  other.cellSize *= 2;
+  EXPECT_THROW(BrickStore::createOrAppend(dir, other), FileError);
+  BrickStore again = BrickStore::createOrAppend(dir, store.header());
+  EXPECT_EQ(again.frames(), std::vector<int>{4});
+}
+
+TEST(BrickStore, MissingOrForeignDirectoryIsAClearError) {
+  fs::path dir = freshDir("foreign");
+  try {
+    BrickStore::open(dir);
+    FAIL();
+  } catch (const FileError& e) {
+    EXPECT_NE(std::string(e.what()).find("store.fsh missing"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+  EXPECT_THROW(BrickStore::open(dir), FileError);
+}
+
+}  // namespace
+}  // namespace flipscope

@@ -1,0 +1,207 @@
+// Binning (convertFrame) against a brute-force oracle, and out-of-core against in-core.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <tuple>
+
+#include "core/AtomicFile.h"
+#include "core/Error.h"
+#include "core/Morton.h"
+#include "preprocess/BrickBinning.h"
+#include "preprocess/Convert.h"
+#include "VectorSource.h"
+
+namespace flipscope {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path freshDir(const std::string& name) {
+  fs::path dir = fs::temp_directory_path() / ("flipscope-convert-" + name + "-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  return dir;
+}
+
+using BrickKey = std::tuple<std::uint32_t, std::uint32_t, std::uint32_t>;
+/// brick -> cell -> attribute values (sorted), computed particle by particle.
+using Oracle = std::map<BrickKey, std::map<std::uint32_t, std::vector<std::uint16_t>>>;
+
+Oracle bruteForce(const std::vector<glm::vec3>& p, const std::vector<glm::vec3>& v, const StoreHeader& h,
+                  std::uint64_t& invalid, std::uint64_t& outside) {
+  Oracle oracle;
+  float smin = std::numeric_limits<float>::max(), smax = -smin;
+  std::vector<int> keep(p.size(), 0);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (!std::isfinite(p[i].x) || !std::isfinite(p[i].y) || !std::isfinite(p[i].z)) {
+      ++invalid;
+      continue;
+    }
+    bool inside = true;
+    for (int a = 0; a < 3; ++a) {
+      const double c = std::floor((double(p[i][a]) - h.origin[a]) / h.cellSize);
+      inside = inside && c >= 0 && c < double(h.brickGrid[a]) * h.brickSize;
+    }
+    if (!inside) {
+      ++outside;
+      continue;
+    }
+    keep[i] = 1;
+    if (!v.empty()) {
+      smin = std::min(smin, glm::length(v[i]));
+      smax = std::max(smax, glm::length(v[i]));
+    }
+  }
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (!keep[i]) continue;
+    std::uint32_t c[3];
+    for (int a = 0; a < 3; ++a) c[a] = std::uint32_t(std::floor((double(p[i][a]) - h.origin[a]) / h.cellSize));
+    const std::uint32_t B = h.brickSize;
+    BrickKey brick{c[0] / B, c[1] / B, c[2] / B};
+    const std::uint32_t cell = c[0] % B + B * (c[1] % B + B * (c[2] % B));
+    const std::uint16_t a = v.empty() ? 0 : detail::quantizeAttribute(glm::length(v[i]), smin, smax);
+    oracle[brick][cell].push_back(a);
+  }
+  for (auto& [brick, cells] : oracle)
+    for (auto& [cell, attrs] : cells) std::sort(attrs.begin(), attrs.end());
+  return oracle;
+}
+
+struct Case {
+  std::uint32_t brickSize;
+  double cellSize;
+  bool attribute;
+};
+
+class ConvertOracle : public ::testing::TestWithParam<Case> {};
+
+TEST_P(ConvertOracle, StoreMatchesBruteForceBinning) {
+  const Case c = GetParam();
+  auto positions = testing::randomParticles(20000, 1000 + c.brickSize, 12.0f);
+  positions[17] = {std::nanf(""), 1, 1};
+  positions[18] = {1, std::numeric_limits<float>::infinity(), 1};
+  positions[19] = {-5, 1, 1};  // outside the domain below
+  std::vector<glm::vec3> velocities;
+  if (c.attribute) {
+    std::mt19937 rng(4);
+    std::uniform_real_distribution<float> u(-3, 3);
+    for (std::size_t i = 0; i < positions.size(); ++i) velocities.push_back({u(rng), u(rng), u(rng)});
+  }
+  ConvertOptions options;
+  options.cellSize = c.cellSize;
+  options.brickSize = c.brickSize;
+  options.progress = Progress::Mode::Silent;
+  const fs::path dir = freshDir("oracle");
+  BrickStore store = BrickStore::createOrAppend(dir, makeStoreHeader(Box{{0, 0, 0}, {12, 12, 12}}, options, c.attribute));
+  testing::VectorSource source(positions, velocities);
+  const FrameReport report = convertFrame(source, store, 0, options);
+
+  std::uint64_t invalid = 0, outside = 0;
+  const Oracle oracle = bruteForce(positions, velocities, store.header(), invalid, outside);
+  EXPECT_EQ(report.stats.skippedInvalid, invalid);
+  EXPECT_EQ(report.stats.skippedOutside, outside);
+  EXPECT_EQ(invalid, 2u);
+  EXPECT_EQ(outside, 1u);
+
+  BrickStore reopened = BrickStore::open(dir);
+  auto frame = reopened.frame(0);
+  ASSERT_EQ(frame->bricks.size(), oracle.size());
+  EXPECT_EQ(frame->stats.particles, positions.size() - invalid - outside);
+  std::uint32_t previous = 0;
+  // Bricks in Morton order, each equal to the oracle's.
+  for (std::uint32_t b = 0; b < frame->bricks.size(); ++b) {
+    const BrickRecord& r = frame->bricks[b];
+    const std::uint32_t code = mortonEncode3(r.coord.x, r.coord.y, r.coord.z);
+    if (b) EXPECT_GT(code, previous);
+    previous = code;
+    EXPECT_EQ(frame->octree.find(r.coord), std::int64_t(b));
+    auto it = oracle.find({r.coord.x, r.coord.y, r.coord.z});
+    ASSERT_NE(it, oracle.end());
+    DecodedBrick d = reopened.readBrick(*frame, b);
+    ASSERT_EQ(d.cells.size(), it->second.size());
+    std::size_t k = 0, a = 0;
+    for (const auto& [cell, attrs] : it->second) {
+      EXPECT_EQ(d.cells[k], cell);
+      EXPECT_EQ(d.counts[k], attrs.size());
+      if (c.attribute) {
+        for (auto value : attrs) EXPECT_EQ(d.attributes[a++], value);
+      }
+      ++k;
+    }
+  }
+  fs::remove_all(dir);
+}
+
+INSTANTIATE_TEST_SUITE_P(BrickSizes, ConvertOracle,
+                         ::testing::Values(Case{32, 0.05, false}, Case{64, 0.02, true}, Case{128, 0.01, true},
+                                           Case{32, 0.5, true}));
+
+TEST(Convert, OutOfCoreStoreIsByteIdenticalToInCore) {
+  // ~1.5 M particles (18 MB of float32, 30 MB with velocities) against a 4 MiB budget.
+  auto positions = testing::randomParticles(1500000, 77, 50.0f);
+  std::vector<glm::vec3> velocities(positions.size());
+  for (std::size_t i = 0; i < positions.size(); ++i) velocities[i] = glm::vec3(std::sin(float(i)), 0.5f, 0);
+  ConvertOptions options;
+  options.cellSize = 0.05;
+  options.progress = Progress::Mode::Silent;
+  const Box domain{{0, 0, 0}, {50, 50, 50}};
+  auto run = [&](std::uint64_t budget, const std::string& name) {
+    options.memoryBudget = budget;
+    const fs::path dir = freshDir(name);
+    BrickStore store = BrickStore::createOrAppend(dir, makeStoreHeader(domain, options, true));
+    testing::VectorSource source(positions, velocities);
+    FrameReport report = convertFrame(source, store, 1, options);
+    return std::make_pair(dir, report);
+  };
+  auto [inCore, inReport] = run(1ull << 30, "incore");
+  auto [outOfCore, outReport] = run(4ull << 20, "outofcore");
+  EXPECT_EQ(inReport.spillBuckets, 0u);
+  EXPECT_GT(outReport.spillBuckets, 1u);
+  EXPECT_EQ(readFile(inCore / "frame_000001.fsf"), readFile(outOfCore / "frame_000001.fsf"));
+  EXPECT_EQ(readFile(inCore / "store.fsh"), readFile(outOfCore / "store.fsh"));
+  // No spill file is left behind.
+  for (const auto& e : fs::directory_iterator(outOfCore))
+    EXPECT_TRUE(e.path().filename() == "store.fsh" || e.path().filename() == "frame_000001.fsf") << e.path();
+  fs::remove_all(inCore);
+  fs::remove_all(outOfCore);
+}
+
+TEST(Convert, SkewedDataSplitsBucketsRecursively) {
+  // Most particles in one corner brick region: the first-level bucket overflows.
+  auto positions = testing::randomParticles(300000, 5, 2.0f);
+  for (std::size_t i = 0; i < positions.size(); i += 50) positions[i] += glm::vec3(40.0f);
+  ConvertOptions options;
+  options.cellSize = 0.01;
+  options.brickSize = 32;
+  options.progress = Progress::Mode::Silent;
+  const Box domain{{0, 0, 0}, {45, 45, 45}};
+  std::vector<std::vector<std::byte>> files;
+  for (std::uint64_t budget : {1ull << 30, 2ull << 20}) {
+    options.memoryBudget = budget;
+    const fs::path dir = freshDir("skew" + std::to_string(budget));
+    BrickStore store = BrickStore::createOrAppend(dir, makeStoreHeader(domain, options, false));
+    testing::VectorSource source(positions);
+    const FrameReport report = convertFrame(source, store, 0, options);
+    if (budget < (1ull << 30)) EXPECT_GT(report.spillBuckets, 4u) << "the overflowing bucket was not split";
+    files.push_back(readFile(dir / "frame_000000.fsf"));
+    fs::remove_all(dir);
+  }
+  EXPECT_EQ(files[0], files[1]);
+}
+
+TEST(Convert, DomainIsDerivedFromTheBoundsAndLimited) {
+  ConvertOptions options;
+  options.resolution = 100;
+  StoreHeader h = makeStoreHeader(Box{{1, 2, 3}, {11, 7, 4}}, options, false);
+  EXPECT_EQ(h.origin, glm::dvec3(1, 2, 3));
+  EXPECT_DOUBLE_EQ(h.cellSize, 0.1);
+  EXPECT_EQ(h.brickGrid, glm::uvec3(2, 1, 1));
+  options.cellSize = 1e-6;
+  EXPECT_THROW(makeStoreHeader(Box{{0, 0, 0}, {1, 1, 1}}, options, false), InputError);
+  EXPECT_THROW(makeStoreHeader(Box{}, ConvertOptions{}, false), InputError);
+}
+
+}  // namespace
+}  // namespace flipscope

@@ -1,0 +1,109 @@
+// Helpers for the particle reader/writer tests: a temporary directory, seeded random
+// particles, whole-file reads and writes, and FileError message checks.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <random>
+#include <string>
+#include <unistd.h>
+
+#include "core/Error.h"
+#include "preprocess/ParticleSource.h"
+#include "preprocess/ParticleWriter.h"
+
+namespace flipscope::testing {
+
+/// A fresh directory under the system temporary directory, removed with its content.
+class TempDir {
+ public:
+  explicit TempDir(const std::string& tag) {
+    static int counter = 0;
+    mPath = std::filesystem::temp_directory_path() /
+            ("flipscope-" + tag + "-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+    std::filesystem::remove_all(mPath);
+    std::filesystem::create_directories(mPath);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(mPath, ec);
+  }
+  const std::filesystem::path& path() const { return mPath; }
+  std::filesystem::path operator/(const std::string& name) const { return mPath / name; }
+
+ private:
+  std::filesystem::path mPath;
+};
+
+/// `count` particles uniform in [-50, 50)^3 (velocities in [-3, 3)^3 when asked), seeded.
+inline ParticleChunk randomParticles(std::size_t count, bool velocity, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> position(-50.f, 50.f), speed(-3.f, 3.f);
+  ParticleChunk chunk;
+  for (std::size_t i = 0; i < count; ++i) {
+    chunk.positions.emplace_back(position(rng), position(rng), position(rng));
+    if (velocity) chunk.velocities.emplace_back(speed(rng), speed(rng), speed(rng));
+  }
+  return chunk;
+}
+
+/// Reads a whole source in chunks of `maxParticles`, checking each chunk's shape.
+inline ParticleChunk readAll(ParticleSource& source, std::size_t maxParticles) {
+  ParticleChunk all, chunk;
+  while (source.read(chunk, maxParticles)) {
+    EXPECT_GT(chunk.size(), 0u);
+    EXPECT_LE(chunk.size(), maxParticles);
+    EXPECT_EQ(chunk.velocities.size(), source.hasVelocity() ? chunk.size() : 0u);
+    all.positions.insert(all.positions.end(), chunk.positions.begin(), chunk.positions.end());
+    all.velocities.insert(all.velocities.end(), chunk.velocities.begin(), chunk.velocities.end());
+  }
+  EXPECT_EQ(chunk.size(), 0u);
+  return all;
+}
+
+inline ParticleChunk readFile(const std::filesystem::path& path, std::size_t maxParticles = 1000,
+                              const ReadOptions& options = {}) {
+  auto source = openParticleFile(path, options);
+  return readAll(*source, maxParticles);
+}
+
+/// Writes `particles` through createParticleWriter in chunks of `chunkSize`.
+inline void writeFile(const std::filesystem::path& path, const ParticleChunk& particles, const WriteOptions& options,
+                      std::size_t chunkSize = 333) {
+  auto writer = createParticleWriter(path, options);
+  for (std::size_t begin = 0; begin < particles.size(); begin += chunkSize) {
+    std::size_t end = std::min(particles.size(), begin + chunkSize);
+    ParticleChunk chunk;
+    chunk.positions.assign(particles.positions.begin() + begin, particles.positions.begin() + end);
+    if (options.velocity)
+      chunk.velocities.assign(particles.velocities.begin() + begin, particles.velocities.begin() + end);
+    writer->write(chunk);
+  }
+  writer->commit();
+}
+
+inline void writeBytes(const std::filesystem::path& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+inline std::string readBytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+/// Expects `work` to throw FileError whose message contains every one of `parts`.
+inline void expectFileError(const std::function<void()>& work, const std::vector<std::string>& parts) {
+  try {
+    work();
+    ADD_FAILURE() << "no FileError thrown; expected one mentioning '" << parts.front() << "'";
+  } catch (const FileError& e) {
+    std::string message = e.what();
+    for (const auto& part : parts) EXPECT_NE(message.find(part), std::string::npos) << "message: " << message;
+  }
+}
+
+}  // namespace flipscope::testing

@@ -1,0 +1,51 @@
+// An in-memory ParticleSource for tests.
+#pragma once
+
+#include <random>
+
+#include "preprocess/ParticleSource.h"
+
+namespace flipscope::testing {
+
+class VectorSource : public ParticleSource {
+ public:
+  VectorSource(std::vector<glm::vec3> positions, std::vector<glm::vec3> velocities = {})
+      : mPositions(std::move(positions)), mVelocities(std::move(velocities)) {}
+  std::string name() const override { return "memory"; }
+  bool hasVelocity() const override { return !mVelocities.empty(); }
+  std::optional<std::uint64_t> countHint() const override { return mPositions.size(); }
+  bool read(ParticleChunk& chunk, std::size_t maxParticles) override {
+    chunk.clear();
+    const std::size_t n = std::min(maxParticles, mPositions.size() - mNext);
+    chunk.positions.assign(mPositions.begin() + mNext, mPositions.begin() + mNext + n);
+    if (!mVelocities.empty()) chunk.velocities.assign(mVelocities.begin() + mNext, mVelocities.begin() + mNext + n);
+    mNext += n;
+    return n > 0;
+  }
+  void rewind() override { mNext = 0; }
+
+ private:
+  std::vector<glm::vec3> mPositions, mVelocities;
+  std::size_t mNext = 0;
+};
+
+/// Clustered random particles: a few dense blobs plus sparse spray, in [0, extent)^3.
+inline std::vector<glm::vec3> randomParticles(std::size_t n, std::uint32_t seed, float extent = 10.0f) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> uniform(0.0f, extent);
+  std::normal_distribution<float> normal(0.0f, extent * 0.05f);
+  std::vector<glm::vec3> centres;
+  for (int i = 0; i < 4; ++i) centres.push_back({uniform(rng), uniform(rng), uniform(rng)});
+  std::vector<glm::vec3> out(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i % 5 == 0) {
+      out[i] = {uniform(rng), uniform(rng), uniform(rng)};
+    } else {
+      glm::vec3 c = centres[i % centres.size()];
+      out[i] = glm::clamp(c + glm::vec3(normal(rng), normal(rng), normal(rng)), glm::vec3(0), glm::vec3(extent * 0.999f));
+    }
+  }
+  return out;
+}
+
+}  // namespace flipscope::testing

@@ -1,0 +1,340 @@
+// Particle readers: chunking, rewind, concatenation, NaN pass-through, every PLY scalar type
+// against an independent PLY encoder, and the error messages for malformed files.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <cstring>
+
+#include "ParticleTestSupport.h"
+
+namespace flipscope {
+namespace {
+
+using testing::expectFileError;
+using testing::randomParticles;
+using testing::readAll;
+using testing::readFile;
+using testing::TempDir;
+using testing::writeBytes;
+using testing::writeFile;
+
+bool sameBits(const glm::vec3& a, const glm::vec3& b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+bool sameParticles(const ParticleChunk& a, const ParticleChunk& b) {
+  if (a.size() != b.size() || a.velocities.size() != b.velocities.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (!sameBits(a.positions[i], b.positions[i]) || (!a.velocities.empty() && !sameBits(a.velocities[i], b.velocities[i])))
+      return false;
+  return true;
+}
+
+// ---- An independent PLY encoder (the oracle for the reader) ----
+
+struct PlyColumn {
+  std::string type;  // PLY type name
+  std::string name;
+};
+
+std::size_t typeBytes(const std::string& type) {
+  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+  if (type == "double" || type == "float64") return 8;
+  return 4;
+}
+
+void appendBinary(std::string& out, const std::string& type, double value, bool bigEndian) {
+  char bytes[8];
+  std::size_t n = typeBytes(type);
+  if (type == "float" || type == "float32") {
+    float f = float(value);
+    std::memcpy(bytes, &f, 4);
+  } else if (type == "double" || type == "float64") {
+    std::memcpy(bytes, &value, 8);
+  } else if (type[0] == 'u') {
+    auto u = static_cast<std::uint64_t>(value);
+    std::memcpy(bytes, &u, n);  // little-endian host: low bytes first
+  } else {
+    auto s = static_cast<std::int64_t>(value);
+    std::memcpy(bytes, &s, n);
+  }
+  if (bigEndian) std::reverse(bytes, bytes + n);
+  out.append(bytes, n);
+}
+
+std::string encodePly(const std::string& format, const std::vector<PlyColumn>& columns,
+                      const std::vector<std::vector<double>>& rows, const std::string& trailingElements = "") {
+  std::string out = "ply\nformat " + format + " 1.0\ncomment made by test_readers\nelement vertex " +
+                    std::to_string(rows.size()) + "\n";
+  for (const auto& c : columns) out += "property " + c.type + " " + c.name + "\n";
+  out += trailingElements + "end_header\n";
+  for (const auto& row : rows) {
+    for (std::size_t i = 0; i < columns.size(); ++i) {
+      if (format == "ascii") {
+        char text[64];
+        std::snprintf(text, sizeof text, "%.17g", row[i]);
+        out += text + std::string(i + 1 < columns.size() ? " " : "\n");
+      } else {
+        appendBinary(out, columns[i].type, row[i], format == "binary_big_endian");
+      }
+    }
+  }
+  return out;
+}
+
+TEST(PlyReader, EveryScalarTypeAndEncodingAgainstEncoder) {
+  const std::vector<std::string> types = {"char",  "uchar", "short", "ushort",  "int",   "uint",   "float",  "double",
+                                          "int8",  "uint8", "int16", "uint16",  "int32", "uint32", "float32", "float64"};
+  const std::vector<std::string> fields = {"x", "y", "z", "vx", "vy", "vz"};
+  std::mt19937 rng(99);
+  TempDir dir("ply-types");
+  for (int trial = 0; trial < 60; ++trial) {
+    // Random layout: the six fields in random order with random types, plus skipped columns.
+    std::vector<PlyColumn> columns;
+    bool velocity = trial % 2 == 0;
+    for (std::size_t f = 0; f < (velocity ? 6u : 3u); ++f) columns.push_back({types[rng() % types.size()], fields[f]});
+    for (int extra = rng() % 4; extra > 0; --extra) columns.push_back({types[rng() % types.size()], "attr" + std::to_string(extra)});
+    columns.push_back({"uchar", "red"});
+    std::shuffle(columns.begin(), columns.end(), rng);
+    std::vector<std::vector<double>> rows(rng() % 40 + 1);
+    for (auto& row : rows)
+      for (const auto& c : columns) {
+        double v = double(rng() % 128);  // fits every type, int8 and unsigned included
+        if (c.type.find("float") != std::string::npos || c.type == "double") v = (double(rng()) / rng.max() - 0.5) * 1e3;
+        row.push_back(c.type == "float" || c.type == "float32" ? double(float(v)) : v);
+      }
+    const char* formats[] = {"ascii", "binary_little_endian", "binary_big_endian"};
+    std::string format = formats[trial % 3];
+    auto path = dir / ("t" + std::to_string(trial) + ".ply");
+    writeBytes(path, encodePly(format, columns, rows, trial % 5 == 0 ? "element face 3\nproperty list uchar int vertex_indices\n" : ""));
+    auto source = openParticleFile(path);
+    ASSERT_EQ(source->hasVelocity(), velocity);
+    auto read = readAll(*source, 7);
+    ASSERT_EQ(read.size(), rows.size());
+    for (std::size_t r = 0; r < rows.size(); ++r)
+      for (std::size_t c = 0; c < columns.size(); ++c)
+        for (std::size_t f = 0; f < fields.size(); ++f)
+          if (columns[c].name == fields[f]) {
+            float got = f < 3 ? read.positions[r][int(f)] : read.velocities[r][int(f - 3)];
+            ASSERT_EQ(got, float(rows[r][c])) << format << " " << columns[c].type << " " << fields[f] << " row " << r;
+          }
+  }
+}
+
+TEST(PlyReader, NaNPassesThrough) {
+  TempDir dir("ply-nan");
+  std::vector<std::vector<double>> rows = {{1, 2, 3}, {NAN, 5, INFINITY}, {7, -NAN, 9}};
+  for (std::string format : {"ascii", "binary_little_endian", "binary_big_endian"}) {
+    writeBytes(dir / "n.ply", encodePly(format, {{"float", "x"}, {"double", "y"}, {"float", "z"}}, rows));
+    auto read = readFile(dir / "n.ply");
+    ASSERT_EQ(read.size(), 3u);
+    EXPECT_EQ(read.positions[0], glm::vec3(1, 2, 3)) << format;
+    EXPECT_TRUE(std::isnan(read.positions[1].x)) << format;
+    EXPECT_TRUE(std::isinf(read.positions[1].z)) << format;
+    EXPECT_TRUE(std::isnan(read.positions[2].y)) << format;
+  }
+}
+
+TEST(RawReader, NaNPassesThrough) {
+  TempDir dir("raw-nan");
+  auto particles = randomParticles(50, false, 4);
+  particles.positions[3].x = NAN;
+  particles.positions[17].z = -INFINITY;
+  writeFile(dir / "n.raw", particles, WriteOptions{});
+  EXPECT_TRUE(sameParticles(readFile(dir / "n.raw", 8), particles));
+}
+
+// ---- Malformed files ----
+
+TEST(RawReader, SizeNotMultipleOf12) {
+  TempDir dir("raw-bad");
+  writeBytes(dir / "r.bin", std::string(25, 'x'));
+  expectFileError([&] { openParticleFile(dir / "r.bin"); }, {"r.bin", "25 bytes", "not a multiple of 12"});
+}
+
+std::string plyHeader(const std::string& body) { return "ply\n" + body + "end_header\n"; }
+
+TEST(PlyReader, MalformedHeaders) {
+  TempDir dir("ply-bad");
+  auto path = dir / "bad.ply";
+  struct Case {
+    std::string bytes;
+    std::vector<std::string> message;
+  };
+  const std::string xyz = "element vertex 1\nproperty float x\nproperty float y\nproperty float z\n";
+  std::vector<Case> cases = {
+      {"plx\nformat ascii 1.0\n", {"bad magic"}},
+      {"", {"bad magic"}},
+      {plyHeader("format binary_middle_endian 1.0\n" + xyz), {"line 2", "unknown format 'binary_middle_endian'"}},
+      {plyHeader("format ascii 2.0\n" + xyz), {"unknown format version '2.0'"}},
+      {plyHeader("format ascii 1.0\nelement vertex 1\nproperty float x\nproperty float z\n"), {"no property 'y'"}},
+      {plyHeader("format ascii 1.0\nelement vertex 1\nproperty half x\n"), {"line 4", "unknown property type 'half' for 'x'"}},
+      {plyHeader("format ascii 1.0\n" + xyz + "property list uchar int n\n"), {"list property 'n' in the vertex element"}},
+      {plyHeader("format ascii 1.0\nelement vertex many\n"), {"malformed element count 'many'"}},
+      {plyHeader("format ascii 1.0\nelement face 2\nproperty list uchar int i\n" + xyz), {"element 'face' before the vertex"}},
+      {plyHeader("format ascii 1.0\nelement face 0\n"), {"no vertex element"}},
+      {plyHeader(xyz), {"before a format line"}},
+      {"ply\nformat ascii 1.0\n" + xyz, {"ends before end_header"}},
+      {plyHeader("format ascii 1.0\nbogus\n" + xyz), {"unknown keyword 'bogus'"}},
+  };
+  for (const auto& c : cases) {
+    writeBytes(path, c.bytes);
+    auto message = c.message;
+    message.push_back("bad.ply");
+    expectFileError([&] { readFile(path); }, message);
+  }
+}
+
+TEST(PlyReader, TruncatedBinaryDataAtEveryLength) {
+  TempDir dir("ply-truncated");
+  std::vector<PlyColumn> columns = {{"double", "x"}, {"uchar", "red"}, {"float", "y"}, {"float", "z"}};
+  std::vector<std::vector<double>> rows(20, {1.5, 200, -2.5, 3.25});
+  for (std::string format : {"binary_little_endian", "binary_big_endian"}) {
+    std::string full = encodePly(format, columns, rows);
+    const std::size_t stride = 17, dataStart = full.size() - rows.size() * stride;
+    for (std::size_t cut = dataStart; cut < full.size(); cut += 5) {
+      writeBytes(dir / "t.ply", full.substr(0, cut));
+      std::size_t whole = (cut - dataStart) / stride;
+      expectFileError([&] { readFile(dir / "t.ply"); },
+                      {"t.ply", "file ends at particle " + std::to_string(whole) + " of 20",
+                       "byte offset " + std::to_string(dataStart + whole * stride)});
+    }
+  }
+}
+
+TEST(PlyReader, AsciiErrorsNameTheLine) {
+  TempDir dir("ply-ascii-bad");
+  std::string header = plyHeader("format ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n");
+  writeBytes(dir / "a.ply", header + "1 2 3\n4 abc 6\n7 8 9\n");
+  expectFileError([&] { readFile(dir / "a.ply"); }, {"a.ply", "line 9", "malformed number 'abc' for property 'y'"});
+  writeBytes(dir / "a.ply", header + "1 2 3\n4 5e 6\n7 8 9\n");
+  expectFileError([&] { readFile(dir / "a.ply"); }, {"line 9", "malformed number '5e'"});
+  writeBytes(dir / "a.ply", header + "1 2 3\n4 5\n");
+  expectFileError([&] { readFile(dir / "a.ply"); }, {"line 9", "expected 3 values for a vertex, found 2"});
+  writeBytes(dir / "a.ply", header + "1 2 3\n4 5 6\n");
+  expectFileError([&] { readFile(dir / "a.ply"); }, {"file ends at particle 2 of 3", "line 10"});
+}
+
+// ---- Chunking, rewind, concatenation, dispatch ----
+
+std::vector<std::filesystem::path> writeEveryFormat(const TempDir& dir, const ParticleChunk& particles) {
+  std::vector<std::filesystem::path> paths;
+  WriteOptions options;
+  options.velocity = !particles.velocities.empty();
+  for (const char* name : {"c.bin", "c.ply", "c.vdb"}) {
+    paths.push_back(dir / name);
+    writeFile(paths.back(), particles, options);
+  }
+  return paths;
+}
+
+TEST(ParticleSource, ChunkSizeDoesNotChangeTheParticles) {
+  TempDir dir("chunks");
+  for (const auto& path : writeEveryFormat(dir, randomParticles(2500, true, 31))) {
+    auto reference = readFile(path, 1 << 20);
+    ASSERT_EQ(reference.size(), 2500u) << path;
+    for (std::size_t maxParticles : {1u, 7u, 1000u}) EXPECT_TRUE(sameParticles(readFile(path, maxParticles), reference)) << path << " " << maxParticles;
+  }
+}
+
+TEST(ParticleSource, RewindRestarts) {
+  TempDir dir("rewind");
+  for (const auto& path : writeEveryFormat(dir, randomParticles(900, true, 32))) {
+    auto source = openParticleFile(path);
+    auto reference = readAll(*source, 1 << 20);
+    source->rewind();
+    ParticleChunk chunk;
+    ASSERT_TRUE(source->read(chunk, 100));
+    ASSERT_TRUE(source->read(chunk, 100));
+    source->rewind();
+    EXPECT_TRUE(sameParticles(readAll(*source, 64), reference)) << path;
+  }
+}
+
+TEST(ParticleSource, ConcatenatedReadsPartsInOrder) {
+  TempDir dir("concat");
+  auto a = randomParticles(300, true, 41), b = randomParticles(200, true, 42);
+  WriteOptions withVelocity;
+  withVelocity.velocity = true;
+  writeFile(dir / "a.ply", a, withVelocity);
+  writeFile(dir / "b.ply", b, withVelocity);
+  writeFile(dir / "b.bin", b, WriteOptions{});
+  ParticleChunk both = a;
+  both.positions.insert(both.positions.end(), b.positions.begin(), b.positions.end());
+  both.velocities.insert(both.velocities.end(), b.velocities.begin(), b.velocities.end());
+
+  std::vector<std::unique_ptr<ParticleSource>> parts;
+  parts.push_back(openParticleFile(dir / "a.ply"));
+  parts.push_back(openParticleFile(dir / "b.ply"));
+  auto source = concatSources(std::move(parts));
+  EXPECT_TRUE(source->hasVelocity());
+  EXPECT_EQ(source->countHint(), 500u);
+  EXPECT_NE(source->name().find("a.ply"), std::string::npos);
+  EXPECT_NE(source->name().find("b.ply"), std::string::npos);
+  EXPECT_TRUE(sameParticles(readAll(*source, 77), both));
+  source->rewind();
+  EXPECT_TRUE(sameParticles(readAll(*source, 1000), both));
+
+  parts.clear();
+  parts.push_back(openParticleFile(dir / "a.ply"));
+  parts.push_back(openParticleFile(dir / "b.bin"));
+  auto mixed = concatSources(std::move(parts));
+  EXPECT_FALSE(mixed->hasVelocity());
+  both.velocities.clear();
+  EXPECT_TRUE(sameParticles(readAll(*mixed, 128), both));
+}
+
+TEST(ParticleSource, DispatchByExtension) {
+  TempDir dir("dispatch");
+  auto particles = randomParticles(20, false, 51);
+  writeFile(dir / "UPPER.PLY", particles, WriteOptions{});
+  EXPECT_TRUE(sameParticles(readFile(dir / "UPPER.PLY"), particles));
+  writeBytes(dir / "p.xyz", "1 2 3\n");
+  expectFileError([&] { openParticleFile(dir / "p.xyz"); }, {"p.xyz", "unknown particle file extension '.xyz'", ".vdb", ".ply", ".bin", ".raw"});
+  expectFileError([&] { openParticleFile(dir / "missing.ply"); }, {"missing.ply", "no such file"});
+}
+
+TEST(ParticleSource, VelocityOptionOff) {
+  TempDir dir("novel");
+  ReadOptions options;
+  options.velocity = false;
+  for (const auto& path : writeEveryFormat(dir, randomParticles(50, true, 52))) {
+    auto source = openParticleFile(path, options);
+    EXPECT_FALSE(source->hasVelocity()) << path;
+    EXPECT_EQ(readAll(*source, 10).size(), 50u);
+  }
+}
+
+// ---- OpenVDB files that are not what they claim ----
+
+TEST(VdbReader, TruncatedAndCorruptedFilesThrowFileError) {
+  TempDir dir("vdb-bad");
+  WriteOptions options;
+  options.velocity = true;
+  writeFile(dir / "good.vdb", randomParticles(3000, true, 61), options);
+  std::string full = testing::readBytes(dir / "good.vdb");
+  std::vector<std::size_t> cuts = {0, 4, 8, 16, 64, 200, full.size() / 4, full.size() / 2, full.size() * 3 / 4, full.size() - 100};
+  for (std::size_t cut : cuts) {
+    writeBytes(dir / "cut.vdb", full.substr(0, cut));
+    expectFileError([&] { readFile(dir / "cut.vdb"); }, {"cut.vdb"});
+  }
+  std::mt19937 rng(62);
+  std::string garbage(5000, '\0');
+  for (char& c : garbage) c = char(rng());
+  writeBytes(dir / "garbage.vdb", garbage);
+  expectFileError([&] { readFile(dir / "garbage.vdb"); }, {"garbage.vdb"});
+  // A valid header followed by garbage.
+  writeBytes(dir / "tail.vdb", full.substr(0, 300) + garbage);
+  expectFileError([&] { readFile(dir / "tail.vdb"); }, {"tail.vdb"});
+}
+
+TEST(VdbReader, UnknownGridNameListsTheGrids) {
+  TempDir dir("vdb-grids");
+  writeFile(dir / "g.vdb", randomParticles(10, false, 63), WriteOptions{});
+  ReadOptions options;
+  options.grids = {"nope"};
+  expectFileError([&] { openParticleFile(dir / "g.vdb", options); }, {"g.vdb", "no grid named 'nope'", "'particles'"});
+}
+
+}  // namespace
+}  // namespace flipscope

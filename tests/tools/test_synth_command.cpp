@@ -1,0 +1,91 @@
+// `flipscope synth` end to end: the files it writes read back as SynthFluid's particles, and
+// bad arguments fail with exit code 2 and a message naming the problem.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "preprocess/ParticleSource.h"
+#include "preprocess/SynthFluid.h"
+
+namespace flipscope {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CommandRun {
+  int exitCode;
+  std::string output;  // stdout and stderr
+};
+
+CommandRun synth(const fs::path& dir, const std::string& arguments) {
+  fs::path log = dir / "log.txt";
+  std::string command =
+      "cd '" + dir.string() + "' && '" FLIPSCOPE_BINARY "' synth " + arguments + " > '" + log.string() + "' 2>&1";
+  int status = std::system(command.c_str());
+  std::ifstream in(log);
+  std::stringstream text;
+  text << in.rdbuf();
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, text.str()};
+}
+
+class SynthCommand : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    mDir = fs::temp_directory_path() / ("flipscope_synth_" + std::to_string(::getpid()));
+    fs::create_directories(mDir);
+  }
+  void TearDown() override { fs::remove_all(mDir); }
+  fs::path mDir;
+};
+
+TEST_F(SynthCommand, PlySequenceReadsBackAsTheGeneratedParticles) {
+  CommandRun run = synth(mDir, "-o f_####.ply --particles 5k --frames 2-3 --seed 9 --velocity");
+  ASSERT_EQ(run.exitCode, 0) << run.output;
+  EXPECT_NE(run.output.find("--cell-size"), std::string::npos) << run.output;
+  for (int frame : {2, 3}) {
+    SynthOptions options;
+    options.particles = 5000;
+    options.seed = 9;
+    options.frame = frame;
+    SynthFluid expected(options);
+    auto file = openParticleFile(mDir / ("f_000" + std::to_string(frame) + ".ply"));
+    ASSERT_TRUE(file->hasVelocity());
+    ASSERT_EQ(file->countHint(), expected.count());
+    ParticleChunk chunk;
+    std::uint64_t index = 0;
+    while (file->read(chunk, 777)) {
+      for (std::size_t i = 0; i < chunk.size(); ++i, ++index) {
+        glm::vec3 p, v;
+        expected.particle(index, p, &v);
+        ASSERT_EQ(chunk.positions[i], p) << "frame " << frame << " particle " << index;
+        ASSERT_EQ(chunk.velocities[i], v) << "frame " << frame << " particle " << index;
+      }
+    }
+    EXPECT_EQ(index, expected.count());
+  }
+}
+
+TEST_F(SynthCommand, BadArgumentsFailWithAMessage) {
+  struct Case {
+    std::string arguments, message;
+  };
+  for (const Case& c :
+       {Case{"-o f.bin --particles 2G", "1k to 1G"}, Case{"-o f.bin --particles 999", "1k to 1G"},
+        Case{"-o f.bin --particles 12x", "--particles: cannot read"},
+        Case{"-o f.bin --particles 1k --frames 0-4", "frame pattern"}, Case{"-o f.vdb --particles 60M", "VDB"}}) {
+    CommandRun run = synth(mDir, c.arguments);
+    EXPECT_EQ(run.exitCode, 2) << c.arguments << ": " << run.output;
+    EXPECT_NE(run.output.find(c.message), std::string::npos) << c.arguments << ": " << run.output;
+  }
+  EXPECT_FALSE(fs::exists(mDir / "f.bin"));
+  EXPECT_FALSE(fs::exists(mDir / "f.vdb"));
+}
+
+}  // namespace
+}  // namespace flipscope

@@ -1,0 +1,78 @@
+#include "tools/CliValues.h"
+
+#include <cmath>
+#include <sstream>
+#include <vector>
+
+#include "core/Error.h"
+
+namespace flipscope::tools {
+namespace {
+
+[[noreturn]] void bad(const std::string& option, const std::string& text, const std::string& expected) {
+  throw InputError(option + ": cannot read '" + text + "', expected " + expected);
+}
+
+/// Splits "2.5M" into 2.5 and "M".
+std::pair<double, std::string> numberAndSuffix(const std::string& option, const std::string& text,
+                                               const std::string& expected) {
+  std::size_t used = 0;
+  double value = 0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    bad(option, text, expected);
+  }
+  if (!std::isfinite(value) || value < 0) bad(option, text, expected);
+  return {value, text.substr(used)};
+}
+
+}  // namespace
+
+std::uint64_t parseCount(const std::string& option, const std::string& text) {
+  const char* expected = "a count such as 1000, 10k, 2.5M or 1G";
+  auto [value, suffix] = numberAndSuffix(option, text, expected);
+  double scale = 1;
+  if (suffix == "k" || suffix == "K") scale = 1e3;
+  else if (suffix == "M" || suffix == "m") scale = 1e6;
+  else if (suffix == "G" || suffix == "g") scale = 1e9;
+  else if (!suffix.empty()) bad(option, text, expected);
+  const double count = std::round(value * scale);
+  if (count > 1e15) bad(option, text, expected);
+  return std::uint64_t(count);
+}
+
+std::uint64_t parseBytes(const std::string& option, const std::string& text) {
+  const char* expected = "a size such as 512M, 4G or 64MiB";
+  auto [value, suffix] = numberAndSuffix(option, text, expected);
+  double scale = 1;
+  if (suffix == "k" || suffix == "K" || suffix == "KiB" || suffix == "kB") scale = 1024.0;
+  else if (suffix == "M" || suffix == "MiB" || suffix == "MB") scale = 1024.0 * 1024;
+  else if (suffix == "G" || suffix == "GiB" || suffix == "GB") scale = 1024.0 * 1024 * 1024;
+  else if (!suffix.empty() && suffix != "B") bad(option, text, expected);
+  const double bytes = std::round(value * scale);
+  if (bytes < 1 || bytes > 1e18) bad(option, text, expected);
+  return std::uint64_t(bytes);
+}
+
+Box parseBox(const std::string& option, const std::string& text) {
+  const char* expected = "six numbers x0,y0,z0,x1,y1,z1";
+  std::vector<double> v;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    try {
+      std::size_t used = 0;
+      v.push_back(std::stod(item, &used));
+      if (used != item.size() || !std::isfinite(v.back())) bad(option, text, expected);
+    } catch (const std::logic_error&) {
+      bad(option, text, expected);
+    }
+  }
+  if (v.size() != 6) bad(option, text, expected);
+  Box box{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
+  if (box.isEmpty()) bad(option, text, "min <= max on every axis");
+  return box;
+}
+
+}  // namespace flipscope::tools

@@ -1,0 +1,19 @@
+// Parsing of command-line values shared by the subcommands: sizes with suffixes, boxes.
+// Every parser throws InputError naming the option and the text it could not read.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "core/Box.h"
+
+namespace flipscope::tools {
+
+/// "1000", "10k", "2.5M", "1G" (powers of 1000) -> count.
+std::uint64_t parseCount(const std::string& option, const std::string& text);
+/// "512M", "4G", "64MiB", "1073741824" (k/M/G and KiB/MiB/GiB are powers of 1024) -> bytes.
+std::uint64_t parseBytes(const std::string& option, const std::string& text);
+/// "x0,y0,z0,x1,y1,z1" -> box with min <= max.
+Box parseBox(const std::string& option, const std::string& text);
+
+}  // namespace flipscope::tools
