@@ -1,0 +1,98 @@
+// StoreBrickSource reads the same bricks back that were written to a BrickStore, and the
+// Streamer over it converts them like over the in-memory source.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+
+#include "core/Morton.h"
+#include "preprocess/FrameFile.h"
+#include "streaming/Streamer.h"
+#include "streaming/SyntheticBrickSource.h"
+
+namespace flipscope {
+namespace {
+
+class StoreBrickSourceTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    mDir = std::filesystem::temp_directory_path() /
+           ("flipscope-store-source-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "-" +
+            std::to_string(reinterpret_cast<std::uintptr_t>(this)));
+    std::filesystem::remove_all(mDir);
+    StoreHeader header;
+    header.brickSize = 32;
+    header.cellSize = 0.01;
+    header.brickGrid = mGrid;
+    header.attribute = AttributeKind::Speed;
+    BrickStore store = BrickStore::createOrAppend(mDir, header);
+    std::vector<glm::uvec3> coords = mSynthetic.bricks(1);
+    std::sort(coords.begin(), coords.end(),
+              [](glm::uvec3 a, glm::uvec3 b) { return mortonEncode3(a.x, a.y, a.z) < mortonEncode3(b.x, b.y, b.z); });
+    FrameWriter writer(store.framePath(1), header, 1);
+    FrameStats stats;
+    for (glm::uvec3 c : coords) {
+      auto brick = mSynthetic.read({1, c});
+      if (!brick) continue;
+      writer.addBrick(c, std::uint32_t(brick->particleCount()), std::uint32_t(brick->cells.size()),
+                      encodeBrick(*brick, 1));
+      stats.particles += brick->particleCount();
+    }
+    writer.finish(stats);
+    store.addFrame(1);
+  }
+  void TearDown() override { std::filesystem::remove_all(mDir); }
+
+  const glm::uvec3 mGrid{3, 3, 3};
+  SyntheticBrickSource mSynthetic{32, mGrid, 3, 0.3};
+  std::filesystem::path mDir;
+};
+
+TEST_F(StoreBrickSourceTest, ReadsWhatWasWritten) {
+  StoreBrickSource source(BrickStore::open(mDir));
+  EXPECT_EQ(source.brickSize(), 32u);
+  for (std::uint32_t z = 0; z < 4; ++z)
+    for (std::uint32_t y = 0; y < 3; ++y)
+      for (std::uint32_t x = 0; x < 3; ++x) {
+        auto expected = mSynthetic.read({1, {x, y, z}});
+        auto read = source.read({1, {x, y, z}});
+        ASSERT_EQ(read != nullptr, expected != nullptr) << x << "," << y << "," << z;
+        if (!read) continue;
+        EXPECT_EQ(read->cells, expected->cells);
+        EXPECT_EQ(read->counts, expected->counts);
+        EXPECT_EQ(read->attributes, expected->attributes);
+      }
+  EXPECT_EQ(source.read({0, {0, 0, 0}}), nullptr);            // no such frame
+  EXPECT_EQ(source.read({1, {0xffffffffu, 0, 0}}), nullptr);  // outside the grid
+}
+
+TEST_F(StoreBrickSourceTest, StreamerOverTheStoreMatchesTheInMemorySource) {
+  StreamerOptions options;
+  options.conversion = {32, 3, AttributeReduction::Max};
+  options.threads = 2;
+  Streamer fromStore(std::make_shared<StoreBrickSource>(BrickStore::open(mDir)), options);
+  Streamer fromMemory(std::make_shared<SyntheticBrickSource>(32, mGrid, 3, 0.3), options);
+  std::vector<glm::uvec3> coords = mSynthetic.bricks(1);
+  for (Streamer* s : {&fromStore, &fromMemory}) {
+    s->setFrame(1);
+    s->request(coords);
+    s->waitIdle();
+  }
+  auto a = fromStore.takeReady(1000), b = fromMemory.takeReady(1000);
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_FALSE(a.empty());
+  auto byMorton = [](const auto& l, const auto& r) {
+    return mortonEncode3(l->key.coord.x, l->key.coord.y, l->key.coord.z) <
+           mortonEncode3(r->key.coord.x, r->key.coord.y, r->key.coord.z);
+  };
+  std::sort(a.begin(), a.end(), byMorton);
+  std::sort(b.begin(), b.end(), byMorton);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i]->key, b[i]->key);
+    EXPECT_EQ(a[i]->bits, b[i]->bits);
+  }
+  EXPECT_EQ(fromStore.stats().failed, 0u) << fromStore.lastError();
+}
+
+}  // namespace
+}  // namespace flipscope
