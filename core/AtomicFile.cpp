@@ -36,8 +36,7 @@ AtomicFile::~AtomicFile() {
 
 void AtomicFile::write(const void* data, std::size_t bytes) {
   FLIPSCOPE_CHECK(mFile, "write after commit");
-  if (bytes && std::fwrite(data, 1, bytes, mFile) != bytes)
-    throw FileError(mTemporary, "write failed: " + errnoText());
+  if (bytes && std::fwrite(data, 1, bytes, mFile) != bytes) throw FileError(mTemporary, "write failed: " + errnoText());
   mOffset += bytes;
 }
 

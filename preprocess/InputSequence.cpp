@@ -125,8 +125,8 @@ std::vector<FrameInput> expandInputs(const std::vector<std::string>& inputs, std
     for (const auto& name : inputs) {
       bool patterned = hasFramePattern(name);
       input.files.emplace_back(substituteFrame(name, frame));
-      expectFile(input.files.back(), patterned ? "frame " + std::to_string(frame) + " of input pattern '" + name + "'"
-                                               : "input file");
+      expectFile(input.files.back(),
+                 patterned ? "frame " + std::to_string(frame) + " of input pattern '" + name + "'" : "input file");
     }
     result.push_back(std::move(input));
   }

@@ -3,7 +3,8 @@
 // `%d`, and `{}` (unpadded frame number). Several inputs per frame (e.g. FLIP and spray files)
 // merge into one frame. With `frames` unset, patterns are matched against the directory
 // listing and every frame number found for the first pattern is used; inputs without a
-// pattern form a single frame (number `frames->first`, or 0).
+// pattern form a single frame (number `frames->first`, or 0); beside patterned inputs they
+// belong to every frame (e.g. a static obstacle). A pattern in a directory name needs `frames`.
 #pragma once
 
 #include <filesystem>

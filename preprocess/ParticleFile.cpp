@@ -21,8 +21,8 @@ ParticleFormat formatOf(const std::filesystem::path& path) {
   if (ext == ".bin" || ext == ".raw") return ParticleFormat::Raw;
   if (ext == ".ply") return ParticleFormat::Ply;
   if (ext == ".vdb") return ParticleFormat::Vdb;
-  throw FileError(path, "unknown particle file extension '" + path.extension().string() + "' (supported: " +
-                            kSupportedExtensions + ")");
+  throw FileError(path, "unknown particle file extension '" + path.extension().string() +
+                            "' (supported: " + kSupportedExtensions + ")");
 }
 
 class ConcatenatedSource final : public ParticleSource {
@@ -75,9 +75,12 @@ std::unique_ptr<ParticleSource> openParticleFile(const std::filesystem::path& pa
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw FileError(path, "no such file");
   switch (format) {
-    case ParticleFormat::Raw: return detail::openRawParticles(path);
-    case ParticleFormat::Ply: return detail::openPlyParticles(path, options);
-    case ParticleFormat::Vdb: return detail::openVdbPoints(path, options);
+    case ParticleFormat::Raw:
+      return detail::openRawParticles(path);
+    case ParticleFormat::Ply:
+      return detail::openPlyParticles(path, options);
+    case ParticleFormat::Vdb:
+      return detail::openVdbPoints(path, options);
   }
   FLIPSCOPE_CHECK(false, "format=" << int(format));
 }
@@ -88,9 +91,12 @@ std::unique_ptr<ParticleSource> concatSources(std::vector<std::unique_ptr<Partic
 
 std::unique_ptr<ParticleWriter> createParticleWriter(const std::filesystem::path& path, const WriteOptions& options) {
   switch (formatOf(path)) {
-    case ParticleFormat::Raw: return detail::createRawWriter(path);
-    case ParticleFormat::Ply: return detail::createPlyWriter(path, options);
-    case ParticleFormat::Vdb: return detail::createVdbWriter(path, options);
+    case ParticleFormat::Raw:
+      return detail::createRawWriter(path);
+    case ParticleFormat::Ply:
+      return detail::createPlyWriter(path, options);
+    case ParticleFormat::Vdb:
+      return detail::createVdbWriter(path, options);
   }
   FLIPSCOPE_CHECK(false, "unknown format");
 }

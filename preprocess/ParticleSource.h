@@ -47,12 +47,15 @@ class ParticleSource {
 struct ReadOptions {
   /// VDB: names of the PointDataGrids to read; empty = every PointDataGrid in the file.
   std::vector<std::string> grids;
-  /// Read velocities when the file has them (`v` in VDB, `vx vy vz` in PLY).
+  /// Read velocities when the file has them (`vx vy vz` in PLY; in VDB the vec3s attribute `v`,
+  /// else Blender Mantaflow's `particles_velocity*`).
   bool velocity = true;
 };
 
-/// Opens a particle file by its extension: .vdb, .ply, .bin/.raw (little-endian float32 xyz).
-/// Throws FileError for unknown extensions, missing files and bad headers.
+/// Opens a particle file by its extension (case-insensitive): .vdb, .ply, .bin/.raw
+/// (little-endian float32 xyz). Throws FileError for unknown extensions, missing files and bad
+/// headers. Memory stays bounded by the chunk size, except for a VDB file's tree topology and
+/// one leaf's attributes (delayed loading).
 std::unique_ptr<ParticleSource> openParticleFile(const std::filesystem::path& path, const ReadOptions& options = {});
 
 /// Reads several sources one after the other as one (e.g. the FLIP and the spray file of one

@@ -3,7 +3,9 @@
 // only), .ply (binary little endian by default; x y z [vx vy vz] as float), .vdb (OpenVDB
 // PointDataGrid named "particles", with a "v" attribute when velocities are written).
 // Raw and PLY stream with constant memory; VDB builds its grid in memory on commit(), so it
-// holds the frame (about 16 bytes a particle).
+// holds the frame (12 bytes a particle, 24 with velocities, plus OpenVDB's index grid while
+// building) and rejects non-finite positions (InputError). Its voxel size, when not given, is
+// chosen by OpenVDB's computeVoxelSize for about 8 points a voxel.
 #pragma once
 
 #include <filesystem>
@@ -30,6 +32,7 @@ class ParticleWriter {
 };
 
 /// Throws FileError for an unknown extension or an unwritable path.
-std::unique_ptr<ParticleWriter> createParticleWriter(const std::filesystem::path& path, const WriteOptions& options = {});
+std::unique_ptr<ParticleWriter> createParticleWriter(const std::filesystem::path& path,
+                                                     const WriteOptions& options = {});
 
 }  // namespace flipscope

@@ -53,13 +53,17 @@ std::optional<PlyType> plyTypeFromName(const std::string& name) {
 std::size_t plyTypeBytes(PlyType type) {
   switch (type) {
     case PlyType::Int8:
-    case PlyType::UInt8: return 1;
+    case PlyType::UInt8:
+      return 1;
     case PlyType::Int16:
-    case PlyType::UInt16: return 2;
+    case PlyType::UInt16:
+      return 2;
     case PlyType::Int32:
     case PlyType::UInt32:
-    case PlyType::Float32: return 4;
-    case PlyType::Float64: return 8;
+    case PlyType::Float32:
+      return 4;
+    case PlyType::Float64:
+      return 8;
   }
   return 0;
 }
@@ -89,14 +93,22 @@ using BinaryDecoder = float (*)(const std::byte*);
 template <bool Swap>
 BinaryDecoder binaryDecoder(PlyType type) {
   switch (type) {
-    case PlyType::Int8: return decodeBinary<std::int8_t, Swap>;
-    case PlyType::UInt8: return decodeBinary<std::uint8_t, Swap>;
-    case PlyType::Int16: return decodeBinary<std::int16_t, Swap>;
-    case PlyType::UInt16: return decodeBinary<std::uint16_t, Swap>;
-    case PlyType::Int32: return decodeBinary<std::int32_t, Swap>;
-    case PlyType::UInt32: return decodeBinary<std::uint32_t, Swap>;
-    case PlyType::Float32: return decodeBinary<float, Swap>;
-    case PlyType::Float64: return decodeBinary<double, Swap>;
+    case PlyType::Int8:
+      return decodeBinary<std::int8_t, Swap>;
+    case PlyType::UInt8:
+      return decodeBinary<std::uint8_t, Swap>;
+    case PlyType::Int16:
+      return decodeBinary<std::int16_t, Swap>;
+    case PlyType::UInt16:
+      return decodeBinary<std::uint16_t, Swap>;
+    case PlyType::Int32:
+      return decodeBinary<std::int32_t, Swap>;
+    case PlyType::UInt32:
+      return decodeBinary<std::uint32_t, Swap>;
+    case PlyType::Float32:
+      return decodeBinary<float, Swap>;
+    case PlyType::Float64:
+      return decodeBinary<double, Swap>;
   }
   return nullptr;
 }
@@ -159,8 +171,8 @@ PlyHeader readPlyHeader(InputFile& file) {
       else if (words[1] == "binary_big_endian")
         header.encoding = PlyEncoding::BinaryBigEndian;
       else
-        throw fail(lineNumber, "unknown format '" + words[1] +
-                                   "' (expected ascii, binary_little_endian or binary_big_endian)");
+        throw fail(lineNumber,
+                   "unknown format '" + words[1] + "' (expected ascii, binary_little_endian or binary_big_endian)");
       if (words[2] != "1.0") throw fail(lineNumber, "unknown format version '" + words[2] + "' (expected 1.0)");
       hasFormat = true;
     } else if (keyword == "element") {
@@ -177,8 +189,7 @@ PlyHeader readPlyHeader(InputFile& file) {
       } else if (seenVertex) {
         element = Element::AfterVertex;
       } else {
-        if (count != 0)
-          throw fail(lineNumber, "element '" + words[1] + "' before the vertex element is not supported");
+        if (count != 0) throw fail(lineNumber, "element '" + words[1] + "' before the vertex element is not supported");
         element = Element::BeforeVertex;
       }
     } else if (keyword == "property") {
@@ -259,8 +270,8 @@ class PlyReader final : public ParticleSource {
     return FileError(mFile.path(), "file ends at particle " + std::to_string(particle) + " of " +
                                        std::to_string(mHeader.vertexCount) + " (byte offset " +
                                        std::to_string(mHeader.dataOffset + particle * mHeader.vertexBytes) +
-                                       ", vertex data starts at byte " + std::to_string(mHeader.dataOffset) +
-                                       ", " + std::to_string(mHeader.vertexBytes) + " bytes a vertex)");
+                                       ", vertex data starts at byte " + std::to_string(mHeader.dataOffset) + ", " +
+                                       std::to_string(mHeader.vertexBytes) + " bytes a vertex)");
   }
 
   void readBinary(ParticleChunk& chunk, std::uint64_t n) {
@@ -286,9 +297,8 @@ class PlyReader final : public ParticleSource {
       std::uint64_t lineNumber = mHeader.headerLines + mNext + k + 1;
       if (!mFile.readLine(mLine, kMaxLineBytes))
         throw FileError(mFile.path(), "file ends at particle " + std::to_string(mNext + k) + " of " +
-                                          std::to_string(mHeader.vertexCount) + " (line " +
-                                          std::to_string(lineNumber) + ", byte offset " +
-                                          std::to_string(mFile.offset()) + ")");
+                                          std::to_string(mHeader.vertexCount) + " (line " + std::to_string(lineNumber) +
+                                          ", byte offset " + std::to_string(mFile.offset()) + ")");
       words.clear();
       for (std::size_t i = 0; i < mLine.size();) {
         while (i < mLine.size() && std::isspace(static_cast<unsigned char>(mLine[i]))) ++i;
@@ -315,8 +325,7 @@ class PlyReader final : public ParticleSource {
         }
         if (parsed.ec != std::errc() || parsed.ptr != word.data() + word.size())
           throw FileError(mFile.path(), "line " + std::to_string(lineNumber) + ": malformed number '" +
-                                            std::string(words[*mFields[field]]) + "' for property '" + prop.name +
-                                            "'");
+                                            std::string(words[*mFields[field]]) + "' for property '" + prop.name + "'");
         return result;
       };
       for (int c = 0; c < 3; ++c) chunk.positions[k][c] = value(c);

@@ -10,7 +10,9 @@
 #include <openvdb/points/PointCount.h>
 #include <openvdb/points/PointDataGrid.h>
 
+#include <cctype>
 #include <cmath>
+#include <fstream>
 #include <mutex>
 #include <ostream>
 #include <sstream>
@@ -38,6 +40,20 @@ void initializeOpenVdb() {
   });
 }
 
+/// OpenVDB's message for a corrupted file may quote megabytes of garbage read as a name:
+/// keep the start, printable characters only, runs of spaces collapsed.
+std::string shortMessage(const char* text) {
+  constexpr std::size_t kMaxLength = 200;
+  std::string result;
+  for (const char* c = text; *c && result.size() < kMaxLength; ++c) {
+    char printable = std::isprint(static_cast<unsigned char>(*c)) ? *c : '?';
+    if (printable == ' ' && !result.empty() && result.back() == ' ') continue;
+    result.push_back(printable);
+  }
+  if (result.size() == kMaxLength) result += "...";
+  return result;
+}
+
 /// Runs `work`, turning OpenVDB's (and the standard library's) exceptions into FileError.
 template <class Work>
 void rethrowAsFileError(const std::filesystem::path& path, Work&& work) {
@@ -50,7 +66,7 @@ void rethrowAsFileError(const std::filesystem::path& path, Work&& work) {
   } catch (const std::bad_alloc&) {
     throw FileError(path, "corrupted OpenVDB file (an allocation failed while reading it)");
   } catch (const std::exception& e) {
-    throw FileError(path, std::string("cannot read OpenVDB file: ") + e.what());
+    throw FileError(path, "corrupted or truncated OpenVDB file: " + shortMessage(e.what()));
   }
 }
 
@@ -122,6 +138,7 @@ class VdbPointsReader final : public ParticleSource {
  private:
   void loadGrids() {
     mGrids.clear();
+    expectVdbMagic();
     openvdb::io::File file(mPath.string());
     file.setCopyMaxBytes(0);  // read in place: no copy of the file to a temporary
     file.open(/*delayLoad=*/true);
@@ -148,10 +165,19 @@ class VdbPointsReader final : public ParticleSource {
       PointGrid g;
       g.grid = openvdb::gridPtrCast<PointDataGrid>(file.readGrid(name));
       for (auto leaf = g.grid->tree().beginLeaf(); leaf; ++leaf) g.leaves.push_back(leaf.getLeaf());
-      if (!g.leaves.empty()) g.hasVelocity = velocityAttribute(g.leaves[0]->attributeSet().descriptor()) != kNoAttribute;
+      if (!g.leaves.empty())
+        g.hasVelocity = velocityAttribute(g.leaves[0]->attributeSet().descriptor()) != kNoAttribute;
       mGrids.push_back(std::move(g));
     }
     file.close();
+  }
+
+  /// Rejects files that are not OpenVDB before OpenVDB parses them.
+  void expectVdbMagic() const {
+    std::int64_t magic = 0;  // written as 64 bits
+    std::ifstream in(mPath, std::ios::binary);
+    if (!in.read(reinterpret_cast<char*>(&magic), sizeof magic) || magic != openvdb::OPENVDB_MAGIC)
+      throw FileError(mPath, "bad magic: not an OpenVDB file");
   }
 
   void readInto(ParticleChunk& chunk, std::size_t maxParticles) {
@@ -251,8 +277,7 @@ constexpr std::uint32_t kPointsPerVoxel = 8;
 
 class VdbPointsWriter final : public ParticleWriter {
  public:
-  VdbPointsWriter(const std::filesystem::path& path, const WriteOptions& options)
-      : mFile(path), mOptions(options) {
+  VdbPointsWriter(const std::filesystem::path& path, const WriteOptions& options) : mFile(path), mOptions(options) {
     initializeOpenVdb();
   }
 
@@ -262,7 +287,8 @@ class VdbPointsWriter final : public ParticleWriter {
     for (std::size_t k = 0; k < chunk.size(); ++k) {
       const glm::vec3& p = chunk.positions[k];
       if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-        throw InputError(mFile.destination().string() + ": OpenVDB points cannot store the non-finite position of particle " +
+        throw InputError(mFile.destination().string() +
+                         ": OpenVDB points cannot store the non-finite position of particle " +
                          std::to_string(mPositions.size()));
       mPositions.emplace_back(p.x, p.y, p.z);
       if (mOptions.velocity) {
@@ -276,14 +302,13 @@ class VdbPointsWriter final : public ParticleWriter {
     namespace points = openvdb::points;
     points::PointAttributeVector<openvdb::Vec3f> positions(mPositions);
     double voxelSize = mOptions.vdbVoxelSize;
-    if (voxelSize <= 0)
-      voxelSize = mPositions.empty() ? 1.0 : points::computeVoxelSize(positions, kPointsPerVoxel);
+    if (voxelSize <= 0) voxelSize = mPositions.empty() ? 1.0 : points::computeVoxelSize(positions, kPointsPerVoxel);
     if (!(voxelSize > 0) || !std::isfinite(voxelSize)) voxelSize = 1.0;
     for (const auto& p : mPositions)
       if (std::abs(p.x()) / voxelSize > kMaxVoxelCoordinate || std::abs(p.y()) / voxelSize > kMaxVoxelCoordinate ||
           std::abs(p.z()) / voxelSize > kMaxVoxelCoordinate)
-        throw InputError(mFile.destination().string() + ": position " + p.str() + " is too far from the origin for voxel size " +
-                         std::to_string(voxelSize));
+        throw InputError(mFile.destination().string() + ": position " + p.str() +
+                         " is too far from the origin for voxel size " + std::to_string(voxelSize));
     auto transform = openvdb::math::Transform::createLinearTransform(voxelSize);
     auto index = openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(positions, *transform);
     auto grid = points::createPointDataGrid<points::NullCodec, PointDataGrid>(*index, positions, *transform);

@@ -4,12 +4,13 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <random>
 #include <string>
-#include <unistd.h>
 
 #include "core/Error.h"
 #include "preprocess/ParticleSource.h"
@@ -49,6 +50,9 @@ inline ParticleChunk randomParticles(std::size_t count, bool velocity, unsigned 
   }
   return chunk;
 }
+
+/// Bit-identical (NaN payloads included).
+inline bool sameBits(const glm::vec3& a, const glm::vec3& b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 /// Reads a whole source in chunks of `maxParticles`, checking each chunk's shape.
 inline ParticleChunk readAll(ParticleSource& source, std::size_t maxParticles) {
@@ -102,6 +106,7 @@ inline void expectFileError(const std::function<void()>& work, const std::vector
     ADD_FAILURE() << "no FileError thrown; expected one mentioning '" << parts.front() << "'";
   } catch (const FileError& e) {
     std::string message = e.what();
+    EXPECT_LT(message.size(), 1000u) << "message not kept short: " << message.substr(0, 300);
     for (const auto& part : parts) EXPECT_NE(message.find(part), std::string::npos) << "message: " << message;
   }
 }

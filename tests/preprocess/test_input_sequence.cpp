@@ -43,7 +43,7 @@ TEST(InputSequence, ParsesFrameRanges) {
 TEST(InputSequence, DiscoversFramesInTheDirectory) {
   TempDir dir("seq-discover");
   for (int f : {12, 3, 100, 7}) touch(dir / substituteFrame("fluid_####.vdb", f));
-  touch(dir / "fluid_12.vdb");   // wrong width: not frame 12 of ####
+  touch(dir / "fluid_12.vdb");    // wrong width: not frame 12 of ####
   touch(dir / "fluid_0x12.vdb");  // not a number
   touch(dir / "other_0005.vdb");
   for (std::string pattern : {"fluid_####.vdb", "fluid_%04d.vdb"}) {
@@ -70,7 +70,8 @@ TEST(InputSequence, FrameRangeAndTwoInputsPerFrame) {
     touch(dir / substituteFrame("data_####.vdb", f));
     touch(dir / substituteFrame("spray_{}.vdb", f));
   }
-  auto frames = expandInputs({(dir / "data_####.vdb").string(), (dir / "spray_{}.vdb").string()}, parseFrameRange("2-4"));
+  auto frames =
+      expandInputs({(dir / "data_####.vdb").string(), (dir / "spray_{}.vdb").string()}, parseFrameRange("2-4"));
   ASSERT_EQ(frames.size(), 3u);
   for (int i = 0; i < 3; ++i) {
     EXPECT_EQ(frames[i].frame, 2 + i);

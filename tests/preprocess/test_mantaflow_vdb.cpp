@@ -87,9 +87,11 @@ TEST(MantaflowVdb, GridsSelectedByName) {
   options.grids = {"particles"};
   EXPECT_EQ(openParticleFile(path, options)->countHint(), openVdbOracle(path).count);
   options.grids = {"velocity"};
-  testing::expectFileError([&] { openParticleFile(path, options); }, {"fluid_data_0030.vdb", "'velocity'", "not a PointDataGrid"});
+  testing::expectFileError([&] { openParticleFile(path, options); },
+                           {"fluid_data_0030.vdb", "'velocity'", "not a PointDataGrid"});
   options.grids = {"foam"};
-  testing::expectFileError([&] { openParticleFile(path, options); }, {"no grid named 'foam'", "'particles'", "'velocity'"});
+  testing::expectFileError([&] { openParticleFile(path, options); },
+                           {"no grid named 'foam'", "'particles'", "'velocity'"});
 }
 
 }  // namespace

@@ -15,16 +15,16 @@ using testing::expectFileError;
 using testing::randomParticles;
 using testing::readAll;
 using testing::readFile;
+using testing::sameBits;
 using testing::TempDir;
 using testing::writeBytes;
 using testing::writeFile;
 
-bool sameBits(const glm::vec3& a, const glm::vec3& b) { return std::memcmp(&a, &b, sizeof a) == 0; }
-
 bool sameParticles(const ParticleChunk& a, const ParticleChunk& b) {
   if (a.size() != b.size() || a.velocities.size() != b.velocities.size()) return false;
   for (std::size_t i = 0; i < a.size(); ++i)
-    if (!sameBits(a.positions[i], b.positions[i]) || (!a.velocities.empty() && !sameBits(a.velocities[i], b.velocities[i])))
+    if (!sameBits(a.positions[i], b.positions[i]) ||
+        (!a.velocities.empty() && !sameBits(a.velocities[i], b.velocities[i])))
       return false;
   return true;
 }
@@ -83,8 +83,8 @@ std::string encodePly(const std::string& format, const std::vector<PlyColumn>& c
 }
 
 TEST(PlyReader, EveryScalarTypeAndEncodingAgainstEncoder) {
-  const std::vector<std::string> types = {"char",  "uchar", "short", "ushort",  "int",   "uint",   "float",  "double",
-                                          "int8",  "uint8", "int16", "uint16",  "int32", "uint32", "float32", "float64"};
+  const std::vector<std::string> types = {"char", "uchar", "short", "ushort", "int",   "uint",   "float",   "double",
+                                          "int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
   const std::vector<std::string> fields = {"x", "y", "z", "vx", "vy", "vz"};
   std::mt19937 rng(99);
   TempDir dir("ply-types");
@@ -93,20 +93,23 @@ TEST(PlyReader, EveryScalarTypeAndEncodingAgainstEncoder) {
     std::vector<PlyColumn> columns;
     bool velocity = trial % 2 == 0;
     for (std::size_t f = 0; f < (velocity ? 6u : 3u); ++f) columns.push_back({types[rng() % types.size()], fields[f]});
-    for (int extra = rng() % 4; extra > 0; --extra) columns.push_back({types[rng() % types.size()], "attr" + std::to_string(extra)});
+    for (int extra = rng() % 4; extra > 0; --extra)
+      columns.push_back({types[rng() % types.size()], "attr" + std::to_string(extra)});
     columns.push_back({"uchar", "red"});
     std::shuffle(columns.begin(), columns.end(), rng);
     std::vector<std::vector<double>> rows(rng() % 40 + 1);
     for (auto& row : rows)
       for (const auto& c : columns) {
         double v = double(rng() % 128);  // fits every type, int8 and unsigned included
-        if (c.type.find("float") != std::string::npos || c.type == "double") v = (double(rng()) / rng.max() - 0.5) * 1e3;
+        if (c.type.find("float") != std::string::npos || c.type == "double")
+          v = (double(rng()) / rng.max() - 0.5) * 1e3;
         row.push_back(c.type == "float" || c.type == "float32" ? double(float(v)) : v);
       }
     const char* formats[] = {"ascii", "binary_little_endian", "binary_big_endian"};
     std::string format = formats[trial % 3];
     auto path = dir / ("t" + std::to_string(trial) + ".ply");
-    writeBytes(path, encodePly(format, columns, rows, trial % 5 == 0 ? "element face 3\nproperty list uchar int vertex_indices\n" : ""));
+    writeBytes(path, encodePly(format, columns, rows,
+                               trial % 5 == 0 ? "element face 3\nproperty list uchar int vertex_indices\n" : ""));
     auto source = openParticleFile(path);
     ASSERT_EQ(source->hasVelocity(), velocity);
     auto read = readAll(*source, 7);
@@ -168,10 +171,13 @@ TEST(PlyReader, MalformedHeaders) {
       {plyHeader("format binary_middle_endian 1.0\n" + xyz), {"line 2", "unknown format 'binary_middle_endian'"}},
       {plyHeader("format ascii 2.0\n" + xyz), {"unknown format version '2.0'"}},
       {plyHeader("format ascii 1.0\nelement vertex 1\nproperty float x\nproperty float z\n"), {"no property 'y'"}},
-      {plyHeader("format ascii 1.0\nelement vertex 1\nproperty half x\n"), {"line 4", "unknown property type 'half' for 'x'"}},
-      {plyHeader("format ascii 1.0\n" + xyz + "property list uchar int n\n"), {"list property 'n' in the vertex element"}},
+      {plyHeader("format ascii 1.0\nelement vertex 1\nproperty half x\n"),
+       {"line 4", "unknown property type 'half' for 'x'"}},
+      {plyHeader("format ascii 1.0\n" + xyz + "property list uchar int n\n"),
+       {"list property 'n' in the vertex element"}},
       {plyHeader("format ascii 1.0\nelement vertex many\n"), {"malformed element count 'many'"}},
-      {plyHeader("format ascii 1.0\nelement face 2\nproperty list uchar int i\n" + xyz), {"element 'face' before the vertex"}},
+      {plyHeader("format ascii 1.0\nelement face 2\nproperty list uchar int i\n" + xyz),
+       {"element 'face' before the vertex"}},
       {plyHeader("format ascii 1.0\nelement face 0\n"), {"no vertex element"}},
       {plyHeader(xyz), {"before a format line"}},
       {"ply\nformat ascii 1.0\n" + xyz, {"ends before end_header"}},
@@ -204,7 +210,8 @@ TEST(PlyReader, TruncatedBinaryDataAtEveryLength) {
 
 TEST(PlyReader, AsciiErrorsNameTheLine) {
   TempDir dir("ply-ascii-bad");
-  std::string header = plyHeader("format ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n");
+  std::string header =
+      plyHeader("format ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n");
   writeBytes(dir / "a.ply", header + "1 2 3\n4 abc 6\n7 8 9\n");
   expectFileError([&] { readFile(dir / "a.ply"); }, {"a.ply", "line 9", "malformed number 'abc' for property 'y'"});
   writeBytes(dir / "a.ply", header + "1 2 3\n4 5e 6\n7 8 9\n");
@@ -233,7 +240,8 @@ TEST(ParticleSource, ChunkSizeDoesNotChangeTheParticles) {
   for (const auto& path : writeEveryFormat(dir, randomParticles(2500, true, 31))) {
     auto reference = readFile(path, 1 << 20);
     ASSERT_EQ(reference.size(), 2500u) << path;
-    for (std::size_t maxParticles : {1u, 7u, 1000u}) EXPECT_TRUE(sameParticles(readFile(path, maxParticles), reference)) << path << " " << maxParticles;
+    for (std::size_t maxParticles : {1u, 7u, 1000u})
+      EXPECT_TRUE(sameParticles(readFile(path, maxParticles), reference)) << path << " " << maxParticles;
   }
 }
 
@@ -290,7 +298,8 @@ TEST(ParticleSource, DispatchByExtension) {
   writeFile(dir / "UPPER.PLY", particles, WriteOptions{});
   EXPECT_TRUE(sameParticles(readFile(dir / "UPPER.PLY"), particles));
   writeBytes(dir / "p.xyz", "1 2 3\n");
-  expectFileError([&] { openParticleFile(dir / "p.xyz"); }, {"p.xyz", "unknown particle file extension '.xyz'", ".vdb", ".ply", ".bin", ".raw"});
+  expectFileError([&] { openParticleFile(dir / "p.xyz"); },
+                  {"p.xyz", "unknown particle file extension '.xyz'", ".vdb", ".ply", ".bin", ".raw"});
   expectFileError([&] { openParticleFile(dir / "missing.ply"); }, {"missing.ply", "no such file"});
 }
 
@@ -313,7 +322,8 @@ TEST(VdbReader, TruncatedAndCorruptedFilesThrowFileError) {
   options.velocity = true;
   writeFile(dir / "good.vdb", randomParticles(3000, true, 61), options);
   std::string full = testing::readBytes(dir / "good.vdb");
-  std::vector<std::size_t> cuts = {0, 4, 8, 16, 64, 200, full.size() / 4, full.size() / 2, full.size() * 3 / 4, full.size() - 100};
+  std::vector<std::size_t> cuts = {
+      0, 4, 8, 16, 64, 200, full.size() / 4, full.size() / 2, full.size() * 3 / 4, full.size() - 100};
   for (std::size_t cut : cuts) {
     writeBytes(dir / "cut.vdb", full.substr(0, cut));
     expectFileError([&] { readFile(dir / "cut.vdb"); }, {"cut.vdb"});

@@ -10,10 +10,9 @@ namespace {
 
 using testing::randomParticles;
 using testing::readFile;
+using testing::sameBits;
 using testing::TempDir;
 using testing::writeFile;
-
-bool sameBits(const glm::vec3& a, const glm::vec3& b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 void expectIdentical(const ParticleChunk& expected, const ParticleChunk& actual) {
   ASSERT_EQ(actual.size(), expected.size());
