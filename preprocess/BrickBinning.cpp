@@ -6,10 +6,12 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 
 #include <glm/geometric.hpp>
 
@@ -29,63 +31,80 @@ KeyGrid::KeyGrid(const StoreHeader& h, std::optional<Box> clipBox)
   FLIPSCOPE_CHECK(cellBits + codeBits + 16 <= 64, "grid too large for 64-bit keys");
 }
 
-void computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, bool attribute, KeyBatch& out) {
+KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, bool attribute, KeyBatch& out) {
   const std::size_t n = chunk.size();
   FLIPSCOPE_CHECK(!attribute || chunk.velocities.size() == n, "attribute needs velocities");
   constexpr std::uint64_t kInvalid = ~0ull, kOutside = ~0ull - 1;
   const std::size_t base = out.cellKeys.size();
   out.cellKeys.resize(base + n);
+  if (attribute) out.speeds.resize(base + n);
   std::uint64_t* keys = out.cellKeys.data() + base;
+  float* speeds = attribute ? out.speeds.data() + base : nullptr;
   const std::uint32_t mask = grid.header.brickSize - 1;
 
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1 << 14), [&](const auto& range) {
-    for (std::size_t i = range.begin(); i != range.end(); ++i) {
-      const glm::vec3 p = chunk.positions[i];
-      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-        keys[i] = kInvalid;
-        continue;
-      }
-      const glm::dvec3 q(p);
-      if (grid.clip && !grid.clip->contains(q)) {
-        keys[i] = kOutside;
-        continue;
-      }
-      const glm::dvec3 c = glm::floor((q - grid.header.origin) * grid.invCellSize);
-      if (c.x < 0 || c.y < 0 || c.z < 0 || c.x >= double(grid.cells.x) || c.y >= double(grid.cells.y) ||
-          c.z >= double(grid.cells.z)) {
-        keys[i] = kOutside;
-        continue;
-      }
-      const glm::uvec3 cell(c);
-      const glm::uvec3 brick = cell >> grid.brickShift;
-      const glm::uvec3 local = cell & mask;
-      const std::uint64_t code = mortonEncode3(brick.x, brick.y, brick.z);
-      const std::uint64_t inBrick = local.x | (local.y << grid.brickShift) | (local.z << (2 * grid.brickShift));
-      keys[i] = (code << grid.cellBits) | inBrick;
-    }
-  });
+  struct Tally {
+    std::uint64_t invalid = 0, outside = 0;
+    float speedMin = std::numeric_limits<float>::infinity(), speedMax = -std::numeric_limits<float>::infinity();
+  };
+  const Tally tally = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, n, 1 << 14), Tally{},
+      [&](const auto& range, Tally t) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+          const glm::vec3 p = chunk.positions[i];
+          if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+            keys[i] = kInvalid;
+            ++t.invalid;
+            continue;
+          }
+          const glm::dvec3 q(p);
+          const glm::dvec3 c = glm::floor((q - grid.header.origin) * grid.invCellSize);
+          if ((grid.clip && !grid.clip->contains(q)) || c.x < 0 || c.y < 0 || c.z < 0 ||
+              c.x >= double(grid.cells.x) || c.y >= double(grid.cells.y) || c.z >= double(grid.cells.z)) {
+            keys[i] = kOutside;
+            ++t.outside;
+            continue;
+          }
+          const glm::uvec3 cell(c);
+          const glm::uvec3 brick = cell >> grid.brickShift;
+          const glm::uvec3 local = cell & mask;
+          const std::uint64_t code = mortonEncode3(brick.x, brick.y, brick.z);
+          const std::uint64_t inBrick = local.x | (local.y << grid.brickShift) | (local.z << (2 * grid.brickShift));
+          keys[i] = (code << grid.cellBits) | inBrick;
+          if (speeds) {
+            const float s = glm::length(chunk.velocities[i]);
+            speeds[i] = std::isfinite(s) ? s : 0.0f;
+            t.speedMin = std::min(t.speedMin, speeds[i]);
+            t.speedMax = std::max(t.speedMax, speeds[i]);
+          }
+        }
+        return t;
+      },
+      [](Tally a, const Tally& b) {
+        a.invalid += b.invalid;
+        a.outside += b.outside;
+        a.speedMin = std::min(a.speedMin, b.speedMin);
+        a.speedMax = std::max(a.speedMax, b.speedMax);
+        return a;
+      });
 
-  // Compact in order (keeps the stream deterministic), counting what was skipped.
-  std::size_t kept = base;
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::uint64_t k = keys[i];
-    if (k == kInvalid) {
-      ++out.invalid;
-    } else if (k == kOutside) {
-      ++out.outside;
-    } else {
-      if (attribute) {
-        const float s = glm::length(chunk.velocities[i]);
-        const float speed = std::isfinite(s) ? s : 0.0f;
-        if (kept == 0) out.speedMin = out.speedMax = speed;
-        out.speedMin = std::min(out.speedMin, speed);
-        out.speedMax = std::max(out.speedMax, speed);
-        out.speeds.push_back(speed);
-      }
-      out.cellKeys[kept++] = k;
-    }
+  const std::size_t skipped = tally.invalid + tally.outside;
+  KeyTally result{n - skipped, tally.invalid, tally.outside, 0, 0};
+  if (attribute && skipped < n) {
+    result.speedMin = tally.speedMin;
+    result.speedMax = tally.speedMax;
   }
-  out.cellKeys.resize(kept);
+  if (skipped == 0) return result;
+  // Rare: compact in order (keeps the stream deterministic).
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (keys[i] == kInvalid || keys[i] == kOutside) continue;
+    keys[kept] = keys[i];
+    if (speeds) speeds[kept] = speeds[i];
+    ++kept;
+  }
+  out.cellKeys.resize(base + kept);
+  if (attribute) out.speeds.resize(base + kept);
+  return result;
 }
 
 std::uint16_t quantizeAttribute(float s, float min, float max) {
@@ -207,7 +226,7 @@ void decodeRun(std::span<std::uint64_t> keys, const KeyGrid& grid, bool attribut
 
 }  // namespace
 
-void binKeys(std::vector<std::uint64_t>& keys, std::vector<std::uint64_t>& scratch, const KeyGrid& grid, bool attribute,
+void binKeys(KeyVector& keys, KeyVector& scratch, const KeyGrid& grid, bool attribute,
              int zstdLevel, const std::function<void(EncodedBrick&&)>& sink) {
   if (keys.empty()) return;
   scratch.resize(keys.size());

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/Box.h"
+#include "core/UninitializedVector.h"
 #include "preprocess/BrickStore.h"
 #include "preprocess/ParticleSource.h"
 
@@ -36,22 +37,29 @@ struct KeyGrid {
   std::uint64_t brickCodeOf(std::uint64_t cellKey) const { return cellKey >> cellBits; }
 };
 
-/// Keys of one chunk: cellKeys (48-bit) and, when `attribute`, speeds (|velocity|).
+using KeyVector = UninitializedVector<std::uint64_t>;
+using SpeedVector = UninitializedVector<float>;
+
+/// Keys of particles: cellKeys (48-bit) and, when the store has an attribute, speeds.
 struct KeyBatch {
-  std::vector<std::uint64_t> cellKeys;
-  std::vector<float> speeds;
-  std::uint64_t invalid = 0;   ///< NaN/Inf
-  std::uint64_t outside = 0;   ///< outside the grid or the clip box
-  float speedMin = 0, speedMax = 0;  ///< over kept particles, valid when !cellKeys.empty()
+  KeyVector cellKeys;
+  SpeedVector speeds;
   void clear() {
     cellKeys.clear();
     speeds.clear();
-    invalid = outside = 0;
   }
 };
 
+/// What computeKeys() kept and skipped.
+struct KeyTally {
+  std::uint64_t kept = 0;
+  std::uint64_t invalid = 0;  ///< NaN/Inf
+  std::uint64_t outside = 0;  ///< outside the grid or the clip box
+  float speedMin = 0, speedMax = 0;  ///< over kept particles, when kept > 0 and with attribute
+};
+
 /// Appends the keys of `chunk` to `out` (parallel over the chunk, deterministic order).
-void computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, bool attribute, KeyBatch& out);
+KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, bool attribute, KeyBatch& out);
 
 /// Quantizes speed s into [0, 65535] over [min, max].
 std::uint16_t quantizeAttribute(float s, float min, float max);
@@ -67,7 +75,7 @@ struct EncodedBrick {
 /// Sorts `keys` (full 64-bit keys, attribute included) by brick, groups them and encodes each
 /// brick; calls `sink` in ascending Morton order. `scratch` is resized to keys.size().
 /// Memory: keys + scratch + one batch of compressed payloads.
-void binKeys(std::vector<std::uint64_t>& keys, std::vector<std::uint64_t>& scratch, const KeyGrid& grid, bool attribute,
+void binKeys(KeyVector& keys, KeyVector& scratch, const KeyGrid& grid, bool attribute,
              int zstdLevel, const std::function<void(EncodedBrick&&)>& sink);
 
 }  // namespace flipscope::detail

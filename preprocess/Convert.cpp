@@ -9,6 +9,10 @@
 #include <cstring>
 #include <memory>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
 #include "core/Error.h"
 #include "preprocess/BrickBinning.h"
 #include "preprocess/FrameFile.h"
@@ -119,7 +123,7 @@ class SpillBuckets {
   }
 
   /// Loads bucket b (after finish()) into keys/speeds.
-  void load(std::size_t b, std::vector<std::uint64_t>& keys, std::vector<float>& speeds) const {
+  void load(std::size_t b, detail::KeyVector& keys, detail::SpeedVector& speeds) const {
     keys.clear();
     speeds.clear();
     keys.reserve(mBuckets[b].records);
@@ -160,36 +164,25 @@ class FrameBinner {
       : mGrid(grid), mAttribute(attribute), mPlan(plan), mOptions(options), mScratch(std::move(scratchDir)),
         mPrefix(".spill-" + std::to_string(::getpid()) + "-" + std::to_string(frame)) {}
 
-  void add(KeyBatch& batch) {
-    mStats.skippedInvalid += batch.invalid;
-    mStats.skippedOutside += batch.outside;
-    if (!batch.cellKeys.empty()) {
-      if (!mHasSpeed) {
-        mStats.attributeMin = batch.speedMin;
-        mStats.attributeMax = batch.speedMax;
-        mHasSpeed = true;
-      }
-      mStats.attributeMin = std::min(mStats.attributeMin, batch.speedMin);
-      mStats.attributeMax = std::max(mStats.attributeMax, batch.speedMax);
-    }
+  void add(const ParticleChunk& chunk) {
     if (mSpill) {
-      mSpill->add(batch.cellKeys.data(), batch.speeds.data(), batch.cellKeys.size());
+      mBatch.clear();
+      account(detail::computeKeys(chunk, mGrid, mAttribute, mBatch));
+      mSpill->add(mBatch.cellKeys.data(), mBatch.speeds.data(), mBatch.cellKeys.size());
       return;
     }
-    if (mKeys.capacity() == 0) {  // reserve address space once: no reallocation copies, pages touched as used
-      mKeys.reserve(mPlan.maxBinParticles + mPlan.chunkParticles);
-      if (mAttribute) mSpeeds.reserve(mPlan.maxBinParticles + mPlan.chunkParticles);
+    if (mKeys.cellKeys.capacity() == 0) {  // reserve address space once: no reallocation copies
+      mKeys.cellKeys.reserve(mPlan.maxBinParticles + mPlan.chunkParticles);
+      if (mAttribute) mKeys.speeds.reserve(mPlan.maxBinParticles + mPlan.chunkParticles);
     }
-    mKeys.insert(mKeys.end(), batch.cellKeys.begin(), batch.cellKeys.end());
-    mSpeeds.insert(mSpeeds.end(), batch.speeds.begin(), batch.speeds.end());
-    if (mKeys.size() > mPlan.maxBinParticles) startSpilling();
+    account(detail::computeKeys(chunk, mGrid, mAttribute, mKeys));
+    if (mKeys.cellKeys.size() > mPlan.maxBinParticles) startSpilling();
   }
 
   /// Bins everything added into `writer`; returns the frame's stats.
   FrameStats finish(FrameWriter& writer) {
-    if (!mAttribute) mStats.attributeMin = mStats.attributeMax = 0;
     if (!mSpill) {
-      binInMemory(mKeys, mSpeeds, writer);
+      binInMemory(mKeys.cellKeys, mKeys.speeds, writer);
     } else {
       mSpill->finish();
       binBuckets(*mSpill, writer);
@@ -199,6 +192,15 @@ class FrameBinner {
   std::uint32_t spillBuckets() const { return mSpillBuckets; }
 
  private:
+  void account(const detail::KeyTally& t) {
+    mStats.skippedInvalid += t.invalid;
+    mStats.skippedOutside += t.outside;
+    if (!mAttribute || t.kept == 0) return;
+    mStats.attributeMin = mHasSpeed ? std::min(mStats.attributeMin, t.speedMin) : t.speedMin;
+    mStats.attributeMax = mHasSpeed ? std::max(mStats.attributeMax, t.speedMax) : t.speedMax;
+    mHasSpeed = true;
+  }
+
   std::uint32_t bucketBitsFor(std::uint32_t availableBits) const {
     std::uint32_t bits = 1;
     while (bits < availableBits && (2ull << bits) <= mPlan.maxBucketFiles) ++bits;
@@ -208,15 +210,15 @@ class FrameBinner {
   void startSpilling() {
     const std::uint32_t bits = bucketBitsFor(mGrid.codeBits);
     mSpill = std::make_unique<SpillBuckets>(mScratch, mPrefix, mGrid.cellBits + mGrid.codeBits - bits, bits, mAttribute);
-    mSpill->add(mKeys.data(), mSpeeds.data(), mKeys.size());
-    std::vector<std::uint64_t>().swap(mKeys);
-    std::vector<float>().swap(mSpeeds);
+    mSpill->add(mKeys.cellKeys.data(), mKeys.speeds.data(), mKeys.cellKeys.size());
+    KeyBatch().cellKeys.swap(mKeys.cellKeys);
+    KeyBatch().speeds.swap(mKeys.speeds);
     mSpillBuckets += std::uint32_t(mSpill->size());
   }
 
   void binBuckets(const SpillBuckets& buckets, FrameWriter& writer) {
-    std::vector<std::uint64_t> keys;
-    std::vector<float> speeds;
+    detail::KeyVector keys;
+    detail::SpeedVector speeds;
     for (std::size_t b = 0; b < buckets.size(); ++b) {
       if (buckets.records(b) == 0) continue;
       if (buckets.records(b) <= mPlan.maxBinParticles) {
@@ -238,19 +240,19 @@ class FrameBinner {
     }
   }
 
-  void binInMemory(std::vector<std::uint64_t>& keys, std::vector<float>& speeds, FrameWriter& writer) {
-    for (std::size_t i = 0; i < keys.size(); ++i) {
-      const std::uint16_t a =
-          mAttribute ? detail::quantizeAttribute(speeds[i], mStats.attributeMin, mStats.attributeMax) : 0;
-      keys[i] = (keys[i] << 16) | a;
-    }
-    std::vector<float>().swap(speeds);
-    std::vector<std::uint64_t> scratch;
+  void binInMemory(detail::KeyVector& keys, detail::SpeedVector& speeds, FrameWriter& writer) {
+    const float lo = mStats.attributeMin, hi = mStats.attributeMax;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, keys.size(), 1 << 16), [&](const auto& range) {
+      for (std::size_t i = range.begin(); i != range.end(); ++i)
+        keys[i] = (keys[i] << 16) | (mAttribute ? detail::quantizeAttribute(speeds[i], lo, hi) : 0);
+    });
+    detail::SpeedVector().swap(speeds);
+    detail::KeyVector scratch;
     detail::binKeys(keys, scratch, mGrid, mAttribute, mOptions.zstdLevel, [&](detail::EncodedBrick&& brick) {
       writer.addBrick(brick.coord, brick.particles, brick.cells, brick.payload);
       mStats.particles += brick.particles;
     });
-    std::vector<std::uint64_t>().swap(keys);
+    detail::KeyVector().swap(keys);
   }
 
   const KeyGrid& mGrid;
@@ -261,8 +263,8 @@ class FrameBinner {
   std::string mPrefix;
   FrameStats mStats;
   bool mHasSpeed = false;
-  std::vector<std::uint64_t> mKeys;
-  std::vector<float> mSpeeds;
+  KeyBatch mKeys;   // in memory, until spilling starts
+  KeyBatch mBatch;  // one chunk, once spilling
   std::unique_ptr<SpillBuckets> mSpill;
   std::uint32_t mSpillBuckets = 0;
 };
@@ -278,8 +280,19 @@ Box scanBounds(ParticleSource& source, std::size_t chunkParticles, Progress* pro
   Box bounds;
   ParticleChunk chunk;
   while (source.read(chunk, chunkParticles)) {
-    for (const auto& p : chunk.positions)
-      if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) bounds.extend(glm::dvec3(p));
+    bounds.extend(tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, chunk.size(), 1 << 15), Box{},
+        [&](const auto& range, Box b) {
+          for (std::size_t i = range.begin(); i != range.end(); ++i) {
+            const glm::vec3 p = chunk.positions[i];
+            if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) b.extend(glm::dvec3(p));
+          }
+          return b;
+        },
+        [](Box a, const Box& b) {
+          a.extend(b);
+          return a;
+        }));
     if (progress) progress->advance(chunk.size());
   }
   source.rewind();
@@ -330,11 +343,8 @@ FrameReport convertFrame(ParticleSource& source, BrickStore& store, int frame, c
 
   FrameBinner binner(grid, attribute, plan, options, scratch, frame);
   ParticleChunk chunk;
-  KeyBatch batch;
   while (source.read(chunk, plan.chunkParticles)) {
-    batch.clear();
-    detail::computeKeys(chunk, grid, attribute, batch);
-    binner.add(batch);
+    binner.add(chunk);
     if (progress) progress->advance(chunk.size());
   }
   FrameWriter writer(store.framePath(frame), header, frame);
