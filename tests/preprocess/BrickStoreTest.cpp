@@ -10,19 +10,13 @@
 #include "core/Error.h"
 #include "preprocess/BrickStore.h"
 #include "preprocess/Convert.h"
+#include "TestSupport.h"
 #include "VectorSource.h"
 
 namespace flipscope {
 namespace {
 
 namespace fs = std::filesystem;
-
-fs::path freshDir(const std::string& name) {
-  fs::path dir = fs::temp_directory_path() / ("flipscope-test-" + name + "-" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
 
 DecodedBrick randomBrick(std::mt19937& rng, std::uint32_t cellsPerBrick, bool attribute) {
   DecodedBrick b;
@@ -131,7 +125,6 @@ void readWholeFrame(const fs::path& file, const StoreHeader& header, const Brick
 class SmallStore : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir = freshDir("small");
     ConvertOptions options;
     options.cellSize = 0.25;
     options.brickSize = 32;
@@ -144,8 +137,8 @@ class SmallStore : public ::testing::Test {
     testing::VectorSource source(positions, velocities);
     convertFrame(source, store, 4, options);
   }
-  void TearDown() override { fs::remove_all(dir); }
-  fs::path dir;
+  testing::TempDir temp{"small-store"};
+  fs::path dir = temp.path();
 };
 
 TEST_F(SmallStore, EveryTruncatedLengthOfTheFrameFileIsRefused) {
@@ -202,15 +195,15 @@ TEST_F(SmallStore, AppendKeepsTheHeaderAndRefusesAnotherDomain) {
 }
 
 TEST(BrickStore, MissingOrForeignDirectoryIsAClearError) {
-  fs::path dir = freshDir("foreign");
+  testing::TempDir temp("foreign");
+  const fs::path dir = temp.path();
   try {
     BrickStore::open(dir);
     FAIL();
   } catch (const FileError& e) {
     EXPECT_NE(std::string(e.what()).find("store.fsh missing"), std::string::npos) << e.what();
   }
-  fs::remove_all(dir);
-  EXPECT_THROW(BrickStore::open(dir), FileError);
+  EXPECT_THROW(BrickStore::open(dir / "missing"), FileError);
 }
 
 }  // namespace

@@ -12,18 +12,13 @@
 #include "core/Morton.h"
 #include "preprocess/BrickBinning.h"
 #include "preprocess/Convert.h"
+#include "TestSupport.h"
 #include "VectorSource.h"
 
 namespace flipscope {
 namespace {
 
 namespace fs = std::filesystem;
-
-fs::path freshDir(const std::string& name) {
-  fs::path dir = fs::temp_directory_path() / ("flipscope-convert-" + name + "-" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  return dir;
-}
 
 using BrickKey = std::tuple<std::uint32_t, std::uint32_t, std::uint32_t>;
 /// brick -> cell -> attribute values (sorted), computed particle by particle.
@@ -93,7 +88,8 @@ TEST_P(ConvertOracle, StoreMatchesBruteForceBinning) {
   options.cellSize = c.cellSize;
   options.brickSize = c.brickSize;
   options.progress = Progress::Mode::Silent;
-  const fs::path dir = freshDir("oracle");
+  testing::TempDir temp("oracle");
+  const fs::path dir = temp / "store";
   BrickStore store = BrickStore::createOrAppend(dir, makeStoreHeader(Box{{0, 0, 0}, {12, 12, 12}}, options, c.attribute));
   testing::VectorSource source(positions, velocities);
   const FrameReport report = convertFrame(source, store, 0, options);
@@ -131,7 +127,6 @@ TEST_P(ConvertOracle, StoreMatchesBruteForceBinning) {
       ++k;
     }
   }
-  fs::remove_all(dir);
 }
 
 INSTANTIATE_TEST_SUITE_P(BrickSizes, ConvertOracle,
@@ -147,9 +142,10 @@ TEST(Convert, OutOfCoreStoreIsByteIdenticalToInCore) {
   options.cellSize = 0.05;
   options.progress = Progress::Mode::Silent;
   const Box domain{{0, 0, 0}, {50, 50, 50}};
+  testing::TempDir temp("out-of-core");
   auto run = [&](std::uint64_t budget, const std::string& name) {
     options.memoryBudget = budget;
-    const fs::path dir = freshDir(name);
+    const fs::path dir = temp / name;
     BrickStore store = BrickStore::createOrAppend(dir, makeStoreHeader(domain, options, true));
     testing::VectorSource source(positions, velocities);
     FrameReport report = convertFrame(source, store, 1, options);
@@ -164,8 +160,6 @@ TEST(Convert, OutOfCoreStoreIsByteIdenticalToInCore) {
   // No spill file is left behind.
   for (const auto& e : fs::directory_iterator(outOfCore))
     EXPECT_TRUE(e.path().filename() == "store.fsh" || e.path().filename() == "frame_000001.fsf") << e.path();
-  fs::remove_all(inCore);
-  fs::remove_all(outOfCore);
 }
 
 TEST(Convert, SkewedDataSplitsBucketsRecursively) {
@@ -178,15 +172,15 @@ TEST(Convert, SkewedDataSplitsBucketsRecursively) {
   options.progress = Progress::Mode::Silent;
   const Box domain{{0, 0, 0}, {45, 45, 45}};
   std::vector<std::vector<std::byte>> files;
+  testing::TempDir temp("skew");
   for (std::uint64_t budget : {1ull << 30, 2ull << 20}) {
     options.memoryBudget = budget;
-    const fs::path dir = freshDir("skew" + std::to_string(budget));
+    const fs::path dir = temp / std::to_string(budget);
     BrickStore store = BrickStore::createOrAppend(dir, makeStoreHeader(domain, options, false));
     testing::VectorSource source(positions);
     const FrameReport report = convertFrame(source, store, 0, options);
     if (budget < (1ull << 30)) EXPECT_GT(report.spillBuckets, 4u) << "the overflowing bucket was not split";
     files.push_back(readFile(dir / "frame_000000.fsf"));
-    fs::remove_all(dir);
   }
   EXPECT_EQ(files[0], files[1]);
 }

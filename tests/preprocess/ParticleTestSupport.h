@@ -15,29 +15,9 @@
 #include "core/Error.h"
 #include "preprocess/ParticleSource.h"
 #include "preprocess/ParticleWriter.h"
+#include "TestSupport.h"
 
 namespace flipscope::testing {
-
-/// A fresh directory under the system temporary directory, removed with its content.
-class TempDir {
- public:
-  explicit TempDir(const std::string& tag) {
-    static int counter = 0;
-    mPath = std::filesystem::temp_directory_path() /
-            ("flipscope-" + tag + "-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
-    std::filesystem::remove_all(mPath);
-    std::filesystem::create_directories(mPath);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(mPath, ec);
-  }
-  const std::filesystem::path& path() const { return mPath; }
-  std::filesystem::path operator/(const std::string& name) const { return mPath / name; }
-
- private:
-  std::filesystem::path mPath;
-};
 
 /// `count` particles uniform in [-50, 50)^3 (velocities in [-3, 3)^3 when asked), seeded.
 inline ParticleChunk randomParticles(std::size_t count, bool velocity, unsigned seed) {

@@ -2,54 +2,34 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include <sys/wait.h>
-
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
+
+#include "TestSupport.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int exitCode;
-  std::string output;  // stdout and stderr
-};
-
-Result run(const std::string& args) {
-  const std::string command = std::string(FLIPSCOPE_BINARY) + " " + args + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  EXPECT_NE(pipe, nullptr);
-  std::string output;
-  std::array<char, 4096> buffer;
-  while (std::size_t n = std::fread(buffer.data(), 1, buffer.size(), pipe)) output.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
-}
+using flipscope::testing::CommandRun;
+CommandRun run(const std::string& args) { return flipscope::testing::runFlipscope(args); }
 
 class Cli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir = fs::temp_directory_path() / ("flipscope-cli-" + std::to_string(::getpid()));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-  }
-  void TearDown() override { fs::remove_all(dir); }
   std::string path(const std::string& name) const { return (dir / name).string(); }
-  fs::path dir;
+  flipscope::testing::TempDir temp{"cli"};
+  const fs::path& dir = temp.path();
 };
 
 TEST_F(Cli, SynthConvertInfoRoundTrip) {
-  Result synth = run("synth -o " + path("fluid_####.ply") + " --particles 20k --frames 1-2 --velocity");
+  CommandRun synth = run("synth -o " + path("fluid_####.ply") + " --particles 20k --frames 1-2 --velocity");
   ASSERT_EQ(synth.exitCode, 0) << synth.output;
-  Result convert = run("convert " + path("fluid_####.ply") + " -o " + path("store") + " --resolution 128 --brick-size 32");
+  CommandRun convert = run("convert " + path("fluid_####.ply") + " -o " + path("store") + " --resolution 128 --brick-size 32");
   ASSERT_EQ(convert.exitCode, 0) << convert.output;
   EXPECT_NE(convert.output.find("frame 2"), std::string::npos) << convert.output;
 
-  Result info = run("info --json --verify " + path("store"));
+  CommandRun info = run("info --json --verify " + path("store"));
   ASSERT_EQ(info.exitCode, 0) << info.output;
   auto j = nlohmann::json::parse(info.output);
   ASSERT_EQ(j["frames"].size(), 2u);
@@ -63,7 +43,7 @@ TEST_F(Cli, SynthConvertInfoRoundTrip) {
 
   // Appending a third frame keeps the store's domain.
   ASSERT_EQ(run("synth -o " + path("extra.ply") + " --particles 20k --frames 3 --velocity").exitCode, 0);
-  Result append = run("convert " + path("extra.ply") + " -o " + path("store"));
+  CommandRun append = run("convert " + path("extra.ply") + " -o " + path("store"));
   EXPECT_EQ(append.exitCode, 0) << append.output;
 }
 
@@ -79,33 +59,33 @@ TEST_F(Cli, DamagedStoreFailsVerifyNamingFileAndBrick) {
     f.put('\x7f');
   }
   EXPECT_EQ(run("info " + path("store")).exitCode, 0);  // the index is intact
-  Result verify = run("info --verify " + path("store"));
+  CommandRun verify = run("info --verify " + path("store"));
   EXPECT_EQ(verify.exitCode, 1) << verify.output;
   EXPECT_NE(verify.output.find("frame_000000.fsf: brick 0"), std::string::npos) << verify.output;
 
   // A truncated frame file is refused by plain info, with exit code 3 (bad input).
   fs::resize_file(frame, fs::file_size(frame) - 5);
-  Result info = run("info " + path("store"));
+  CommandRun info = run("info " + path("store"));
   EXPECT_EQ(info.exitCode, 3) << info.output;
   EXPECT_NE(info.output.find("frame_000000.fsf"), std::string::npos) << info.output;
 }
 
 TEST_F(Cli, BadInputsGiveClearErrorsAndExitCodes) {
   std::ofstream(path("odd.bin"), std::ios::binary) << "12345678901234";  // 14 bytes: not a multiple of 12
-  Result odd = run("convert " + path("odd.bin") + " -o " + path("s1"));
+  CommandRun odd = run("convert " + path("odd.bin") + " -o " + path("s1"));
   EXPECT_EQ(odd.exitCode, 3) << odd.output;
   EXPECT_NE(odd.output.find("odd.bin"), std::string::npos) << odd.output;
   EXPECT_FALSE(fs::exists(dir / "s1" / "frame_000000.fsf"));
 
-  Result missing = run("convert " + path("nothing.ply") + " -o " + path("s2"));
+  CommandRun missing = run("convert " + path("nothing.ply") + " -o " + path("s2"));
   EXPECT_NE(missing.exitCode, 0);
   EXPECT_NE(missing.output.find("nothing.ply"), std::string::npos) << missing.output;
 
-  Result badMem = run("convert " + path("odd.bin") + " -o " + path("s3") + " --mem lots");
+  CommandRun badMem = run("convert " + path("odd.bin") + " -o " + path("s3") + " --mem lots");
   EXPECT_EQ(badMem.exitCode, 2) << badMem.output;
   EXPECT_NE(badMem.output.find("--mem"), std::string::npos) << badMem.output;
 
-  Result notStore = run("info " + path(""));
+  CommandRun notStore = run("info " + path(""));
   EXPECT_EQ(notStore.exitCode, 3) << notStore.output;
   EXPECT_NE(notStore.output.find("store.fsh missing"), std::string::npos) << notStore.output;
 
@@ -115,7 +95,7 @@ TEST_F(Cli, BadInputsGiveClearErrorsAndExitCodes) {
 TEST_F(Cli, OutOfCoreConvertMatchesInCore) {
   ASSERT_EQ(run("synth -o " + path("big.bin") + " --particles 600k").exitCode, 0);
   ASSERT_EQ(run("convert " + path("big.bin") + " -o " + path("a") + " --resolution 256 -q").exitCode, 0);
-  Result out = run("convert " + path("big.bin") + " -o " + path("b") + " --resolution 256 --mem 2M");
+  CommandRun out = run("convert " + path("big.bin") + " -o " + path("b") + " --resolution 256 --mem 2M");
   ASSERT_EQ(out.exitCode, 0) << out.output;
   EXPECT_NE(out.output.find("out of core"), std::string::npos) << out.output;
   auto bytes = [](const fs::path& p) {

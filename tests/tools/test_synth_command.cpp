@@ -12,36 +12,23 @@
 
 #include "preprocess/ParticleSource.h"
 #include "preprocess/SynthFluid.h"
+#include "TestSupport.h"
 
 namespace flipscope {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CommandRun {
-  int exitCode;
-  std::string output;  // stdout and stderr
-};
+using testing::CommandRun;
 
 CommandRun synth(const fs::path& dir, const std::string& arguments) {
-  fs::path log = dir / "log.txt";
-  std::string command =
-      "cd '" + dir.string() + "' && '" FLIPSCOPE_BINARY "' synth " + arguments + " > '" + log.string() + "' 2>&1";
-  int status = std::system(command.c_str());
-  std::ifstream in(log);
-  std::stringstream text;
-  text << in.rdbuf();
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, text.str()};
+  return testing::runFlipscope("synth " + arguments, dir);
 }
 
 class SynthCommand : public ::testing::Test {
  protected:
-  void SetUp() override {
-    mDir = fs::temp_directory_path() / ("flipscope_synth_" + std::to_string(::getpid()));
-    fs::create_directories(mDir);
-  }
-  void TearDown() override { fs::remove_all(mDir); }
-  fs::path mDir;
+  testing::TempDir mTemp{"synth-command"};
+  const fs::path& mDir = mTemp.path();
 };
 
 TEST_F(SynthCommand, PlySequenceReadsBackAsTheGeneratedParticles) {

@@ -1,0 +1,55 @@
+// Helpers every test suite shares: scratch directories and running the flipscope binary.
+#pragma once
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+namespace flipscope::testing {
+
+/// A fresh directory under the system temporary directory, removed with its content.
+class TempDir {
+ public:
+  explicit TempDir(const std::string& tag) {
+    static int counter = 0;
+    mPath = std::filesystem::temp_directory_path() /
+            ("flipscope-" + tag + "-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+    std::filesystem::remove_all(mPath);
+    std::filesystem::create_directories(mPath);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(mPath, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::filesystem::path& path() const { return mPath; }
+  std::filesystem::path operator/(const std::string& name) const { return mPath / name; }
+
+ private:
+  std::filesystem::path mPath;
+};
+
+struct CommandRun {
+  int exitCode;
+  std::string output;  ///< stdout and stderr together
+};
+
+/// Runs `flipscope <arguments>` (a shell fragment) in `directory` (or the current one).
+inline CommandRun runFlipscope(const std::string& arguments, const std::filesystem::path& directory = {}) {
+  std::string command = "'" FLIPSCOPE_BINARY "' " + arguments + " 2>&1";
+  if (!directory.empty()) command = "cd '" + directory.string() + "' && " + command;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return {-1, "popen failed"};
+  std::string output;
+  std::array<char, 4096> buffer;
+  while (std::size_t n = std::fread(buffer.data(), 1, buffer.size(), pipe)) output.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
+}  // namespace flipscope::testing
