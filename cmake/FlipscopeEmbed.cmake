@@ -19,7 +19,8 @@ function(flipscope_embed_text)
     COMMAND ${CMAKE_COMMAND} -DNAMESPACE=${ARG_TARGET} -DOUT_HEADER=${_header} -DOUT_SOURCE=${_source}
             "-DFILES=${_abs_files}" -P "${PROJECT_SOURCE_DIR}/cmake/EmbedText.cmake"
     DEPENDS ${_abs_files} "${PROJECT_SOURCE_DIR}/cmake/EmbedText.cmake"
-    COMMENT "Embedding text files into ${ARG_TARGET}")
+    COMMENT "Embedding text files into ${ARG_TARGET}"
+    VERBATIM)  # keeps the FILES list one argument
   target_sources(${ARG_TARGET} PRIVATE "${_source}" "${_header}")
   target_include_directories(${ARG_TARGET} PUBLIC "${_out_dir}")
 endfunction()

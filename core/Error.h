@@ -55,11 +55,11 @@ namespace detail {
 }  // namespace flipscope
 
 /// Always-on invariant check: FLIPSCOPE_CHECK(a == b, "a=" << a << " b=" << b).
-#define FLIPSCOPE_CHECK(cond, ...)                                                         \
-  do {                                                                                      \
-    if (!(cond)) {                                                                          \
-      std::ostringstream flipscope_check_os_;                                               \
-      flipscope_check_os_ __VA_OPT__(<< __VA_ARGS__);                                      \
+#define FLIPSCOPE_CHECK(cond, ...)                                                            \
+  do {                                                                                        \
+    if (!(cond)) {                                                                            \
+      std::ostringstream flipscope_check_os_;                                                 \
+      (void)(flipscope_check_os_ __VA_OPT__(<< __VA_ARGS__));                                 \
       ::flipscope::detail::checkFailed(#cond, __FILE__, __LINE__, flipscope_check_os_.str()); \
-    }                                                                                       \
+    }                                                                                         \
   } while (0)

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <bit>
+#include <cmath>
 #include <cstdint>
 
 #include <glm/glm.hpp>
@@ -18,19 +19,25 @@
 
 namespace flipscope::glsl {
 using uint = std::uint32_t;
+using glm::abs;
+using glm::clamp;
+using glm::dot;
+using glm::floor;
 using glm::ivec2;
 using glm::ivec3;
 using glm::ivec4;
+using glm::max;
+using glm::min;
+using glm::normalize;
 using glm::uvec2;
 using glm::uvec3;
 using glm::uvec4;
 using glm::vec2;
 using glm::vec3;
 using glm::vec4;
-using glm::clamp;
-using glm::dot;
-using glm::max;
-using glm::min;
+using std::abs;
+using std::floor;
+using std::sqrt;
 
 inline int bitCount(uint v) { return std::popcount(v); }
 inline int findLSB(uint v) { return v == 0 ? -1 : std::countr_zero(v); }

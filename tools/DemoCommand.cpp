@@ -1,5 +1,5 @@
-// flipscope demo: the main job on generated data, from nothing to a brick store (and, once
-// the renderer is built in, a preview image): synth frames -> convert -> info.
+// flipscope demo: the main job on generated data, from nothing to a preview image:
+// synth frames -> convert into a brick store -> info -> render the last frame to PNG.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -12,6 +12,7 @@
 #include "preprocess/SynthFluid.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
+#include "tools/RenderJob.h"
 
 namespace flipscope::tools {
 namespace {
@@ -22,6 +23,8 @@ struct DemoArgs {
   std::string output = "flipscope-demo";
   std::string particles = "2M";
   int frames = 3;
+  std::string size = "960x540";
+  std::string device = "auto";
 };
 
 void runDemo(const DemoArgs& a) {
@@ -53,16 +56,36 @@ void runDemo(const DemoArgs& a) {
                 s.frame, (unsigned long long)s.particles, s.bricks, s.bitsPerParticle, s.ratioToRaw);
   }
   std::printf("demo: wrote brick store %s (inspect with: flipscope info %s)\n", storeDir.c_str(), storeDir.c_str());
+
+  RenderJob job;
+  job.store = storeDir.string();
+  job.output = (out / "preview.png").string();
+  job.firstFrame = job.lastFrame = a.frames - 1;
+  unsigned width = 0, height = 0;
+  if (std::sscanf(a.size.c_str(), "%ux%u", &width, &height) != 2)
+    throw InputError("--size: expected WxH, got '" + a.size + "'");
+  job.settings.width = width;
+  job.settings.height = height;
+  validate(job.settings);
+  job.device = a.device == "gpu" ? DeviceChoice::Gpu : a.device == "cpu" ? DeviceChoice::Cpu : DeviceChoice::Auto;
+  runRenderJob(job);
+  std::printf("demo: wrote preview image %s (render more with: flipscope render %s -o out_####.exr --frames 0-%d)\n",
+              job.output.c_str(), storeDir.c_str(), a.frames - 1);
 }
 
 }  // namespace
 
 void addDemoCommand(CLI::App& app) {
   auto args = std::make_shared<DemoArgs>();
-  auto* cmd = app.add_subcommand("demo", "The main job on generated data: synth -> convert -> info");
+  auto* cmd =
+      app.add_subcommand("demo", "The main job on generated data: synth -> convert -> info -> render a preview");
   cmd->add_option("-o,--output", args->output, "Output directory")->capture_default_str();
   cmd->add_option("--particles", args->particles, "Synth particles per frame")->capture_default_str();
   cmd->add_option("--frames", args->frames, "Frames to generate")->check(CLI::Range(1, 1000))->capture_default_str();
+  cmd->add_option("--size", args->size, "Preview image size WxH")->capture_default_str();
+  cmd->add_option("--device", args->device, "auto, gpu or cpu")
+      ->check(CLI::IsMember({"auto", "gpu", "cpu"}))
+      ->capture_default_str();
   cmd->callback([args] { runDemo(*args); });
 }
 

@@ -1,13 +1,113 @@
+// flipscope render: brick store frames -> EXR (R G B A Z N.*) or PNG previews, headless.
 #include <CLI/CLI.hpp>
 
+#include <memory>
+
 #include "core/Error.h"
+#include "preprocess/InputSequence.h"
+#include "tools/CliValues.h"
 #include "tools/Commands.h"
+#include "tools/RenderJob.h"
 
 namespace flipscope::tools {
+namespace {
+
+struct RenderArgs {
+  std::string store;
+  std::string output;
+  std::optional<int> frame;
+  std::string frames;
+  std::string size = "1280x720";
+  std::string camera;
+  std::string cameraFile;
+  std::string up = "y";
+  float radius = 1.0f;
+  std::string jitter = "on";
+  std::string gpuMem = "1G";
+  std::string cpuMem = "2G";
+  std::string device = "auto";
+  int maxPasses = 1000;
+  bool quiet = false;
+};
+
+void parseSize(const std::string& text, RenderSettings& settings) {
+  unsigned w = 0, h = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%u%c%u%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X'))
+    throw InputError("--size: expected WxH (e.g. 1920x1080), got '" + text + "'");
+  settings.width = w;
+  settings.height = h;
+}
+
+float parseJitter(const std::string& text) {
+  if (text == "on") return 0.25f;
+  if (text == "off") return 0.0f;
+  try {
+    std::size_t used = 0;
+    const float cells = std::stof(text, &used);
+    if (used == text.size()) return cells;
+  } catch (const std::exception&) {
+  }
+  throw InputError("--jitter: expected on, off or a number of cells, got '" + text + "'");
+}
+
+glm::dvec3 parseUp(const std::string& text) {
+  if (text == "x") return {1, 0, 0};
+  if (text == "y") return {0, 1, 0};
+  if (text == "z") return {0, 0, 1};
+  throw InputError("--up: expected x, y or z, got '" + text + "'");
+}
+
+void runRender(const RenderArgs& a) {
+  RenderJob job;
+  job.store = a.store;
+  job.output = a.output;
+  if (a.frame) job.firstFrame = job.lastFrame = *a.frame;
+  if (!a.frames.empty()) {
+    const FrameRange range = parseFrameRange(a.frames);
+    job.firstFrame = range.first;
+    job.lastFrame = range.last;
+  }
+  parseSize(a.size, job.settings);
+  job.settings.radius = a.radius;
+  job.settings.jitter = parseJitter(a.jitter);
+  job.settings.gpuBudgetBytes = parseBytes("--gpu-mem", a.gpuMem);
+  job.settings.cpuCacheBytes = parseBytes("--cpu-mem", a.cpuMem);
+  job.settings.maxPasses = a.maxPasses;
+  validate(job.settings);
+  if (!a.camera.empty()) job.camera = parseCamera("--camera", a.camera);
+  if (!a.cameraFile.empty()) job.camera = loadCamera(a.cameraFile);
+  job.up = parseUp(a.up);
+  job.device = a.device == "gpu" ? DeviceChoice::Gpu : a.device == "cpu" ? DeviceChoice::Cpu : DeviceChoice::Auto;
+  job.quiet = a.quiet;
+  runRenderJob(job);
+}
+
+}  // namespace
 
 void addRenderCommand(CLI::App& app) {
-  auto* cmd = app.add_subcommand("render", "(not yet implemented)");
-  cmd->callback([] { throw InputError("render: not yet implemented"); });
+  auto args = std::make_shared<RenderArgs>();
+  auto* cmd = app.add_subcommand("render", "Render brick store frames headless to EXR (R G B A Z N) or PNG");
+  cmd->add_option("store", args->store, "Brick store directory")->required();
+  cmd->add_option("-o,--output", args->output, "Output .exr or .png; '####' takes the frame number")->required();
+  auto* frame = cmd->add_option("--frame", args->frame, "Frame to render (default: the first)");
+  cmd->add_option("--frames", args->frames, "Frame range A-B (a flipbook; needs '#' in the output name)")
+      ->excludes(frame);
+  cmd->add_option("--size", args->size, "Image size WxH")->capture_default_str();
+  auto* camera = cmd->add_option("--camera", args->camera, "ex,ey,ez,tx,ty,tz,ux,uy,uz,fov (world units, degrees)");
+  cmd->add_option("--camera-file", args->cameraFile, "JSON {\"eye\", \"target\", \"up\", \"fov\"}")->excludes(camera);
+  cmd->add_option("--up", args->up, "Up axis of the default camera framed on the data (x, y or z)")
+      ->capture_default_str();
+  cmd->add_option("--radius", args->radius, "Sphere radius in cells")->capture_default_str();
+  cmd->add_option("--jitter", args->jitter, "Per-cell jitter: on (0.25 cells), off, or cells")->capture_default_str();
+  cmd->add_option("--gpu-mem", args->gpuMem, "Brick pool budget on the device")->capture_default_str();
+  cmd->add_option("--cpu-mem", args->cpuMem, "Converted-brick cache in CPU memory")->capture_default_str();
+  cmd->add_option("--device", args->device, "auto: OpenGL through EGL, else the CPU reference; gpu; cpu")
+      ->check(CLI::IsMember({"auto", "gpu", "cpu"}))
+      ->capture_default_str();
+  cmd->add_option("--max-passes", args->maxPasses, "Ray-casting passes per frame at most")->capture_default_str();
+  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing");
+  cmd->callback([args] { runRender(*args); });
 }
 
 }  // namespace flipscope::tools

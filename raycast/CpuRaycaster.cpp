@@ -1,0 +1,120 @@
+#include "raycast/CpuRaycaster.h"
+
+#include <chrono>
+#include <thread>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "core/Error.h"
+#include "streaming/BitBrickLayout.h"
+#include "streaming/Jitter.h"
+
+namespace flipscope {
+
+namespace glsl {
+namespace {
+/// Raycast.glsl compiled as C++: its functions become members, so the accessors it calls (and
+/// the parameter block P) are this struct's members, as they are globals in Raycast.comp.
+struct RaycastKernel {
+  RaycastParams P;
+  const CpuRaycaster::Pool* pool;
+  std::atomic<std::uint8_t>* requestFlags;
+
+  uvec2 rcNode(uint node) const { return pool->nodes[node]; }
+  uint rcPage(uint brickIndex) const { return pool->pageTable[brickIndex]; }
+  uvec4 rcSubBrick(uint slot, uint subBrick) const { return pool->subBricks[std::size_t(slot) * P.brick.w + subBrick]; }
+  uint rcMipWord(uint slot, uint word) const { return pool->mipWords[std::size_t(slot) * P.pool.x + word]; }
+  uint rcAttributeBase(uint slot, uint subBrick) const {
+    return pool->attributeBases[std::size_t(slot) * P.brick.w + subBrick];
+  }
+  uint rcAttribute(uint index) const { return pool->attributes[index]; }
+  void rcRequest(uint brickIndex) const { requestFlags[brickIndex].store(1, std::memory_order_relaxed); }
+
+#include "raycast/glsl/Raycast.glsl"
+};
+}  // namespace
+}  // namespace glsl
+
+std::vector<std::uint32_t> attributeBases(const BitBrick& bits, std::uint64_t attributeOffset) {
+  std::vector<std::uint32_t> bases(bits.subBricks.size(), 0);
+  if (!bits.hasAttributes()) return bases;
+  for (std::uint32_t i = 0; i < bases.size(); ++i) {
+    const std::uint64_t base = attributeOffset + bits.attributeBase(i);
+    FLIPSCOPE_CHECK(base <= 0xffffffffu, "attribute ring beyond 32-bit indices");
+    bases[i] = std::uint32_t(base);
+  }
+  return bases;
+}
+
+std::string CpuRaycaster::name() const {
+  return "CPU reference (" + std::to_string(std::thread::hardware_concurrency()) + " threads)";
+}
+
+void CpuRaycaster::allocatePool(const PoolLayout& layout) {
+  mPool.layout = layout;
+  mPool.subBricks.assign(std::size_t(layout.slots) * layout.subBricksPerSlot, glm::uvec4(0));
+  mPool.mipWords.assign(std::size_t(layout.slots) * layout.mipWordsPerSlot, 0);
+  mPool.attributeBases.assign(layout.attributes ? std::size_t(layout.slots) * layout.subBricksPerSlot : 0, 0);
+  mPool.attributes.assign(layout.attributeCapacity, 0);
+}
+
+void CpuRaycaster::setOctree(std::span<const OctreeNode> nodes) {
+  mPool.nodes.resize(nodes.size());
+  for (std::size_t i = 0; i < nodes.size(); ++i) mPool.nodes[i] = {nodes[i].childMask, nodes[i].firstChild};
+}
+
+void CpuRaycaster::setPageTable(std::span<const std::uint32_t> pageTable) {
+  mPool.pageTable.assign(pageTable.begin(), pageTable.end());
+}
+
+void CpuRaycaster::uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset, const ConvertedBrick& brick) {
+  const PoolLayout& layout = mPool.layout;
+  FLIPSCOPE_CHECK(slot < layout.slots && brick.bits.subBricks.size() == layout.subBricksPerSlot &&
+                  brick.mipmap.size() == layout.mipWordsPerSlot);
+  std::copy(brick.bits.subBricks.begin(), brick.bits.subBricks.end(),
+            mPool.subBricks.begin() + std::size_t(slot) * layout.subBricksPerSlot);
+  std::copy(brick.mipmap.begin(), brick.mipmap.end(),
+            mPool.mipWords.begin() + std::size_t(slot) * layout.mipWordsPerSlot);
+  if (layout.attributes) {
+    const auto bases = attributeBases(brick.bits, attributeOffset);
+    std::copy(bases.begin(), bases.end(), mPool.attributeBases.begin() + std::size_t(slot) * layout.subBricksPerSlot);
+    FLIPSCOPE_CHECK(attributeOffset + brick.bits.attributes.size() <= mPool.attributes.size());
+    std::copy(brick.bits.attributes.begin(), brick.bits.attributes.end(), mPool.attributes.begin() + attributeOffset);
+  }
+}
+
+void CpuRaycaster::beginImage(std::uint32_t width, std::uint32_t height) {
+  mWidth = width;
+  mHeight = height;
+  RayHit pending{};
+  pending.status = kRayPending;
+  pending.brickIndex = kNotResident;
+  mHits.assign(std::size_t(width) * height, pending);
+}
+
+std::vector<std::uint32_t> CpuRaycaster::trace(const RaycastParams& params) {
+  FLIPSCOPE_CHECK(params.image.x == mWidth && params.image.y == mHeight);
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t brickCount = mPool.pageTable.size();
+  std::unique_ptr<std::atomic<std::uint8_t>[]> flags(
+      new std::atomic<std::uint8_t>[std::max<std::size_t>(brickCount, 1)]);
+  for (std::size_t i = 0; i < brickCount; ++i) flags[i].store(0, std::memory_order_relaxed);
+  const glsl::RaycastKernel kernel{params, &mPool, flags.get()};
+  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, mHeight), [&](const tbb::blocked_range<std::uint32_t>& rows) {
+    glsl::RaycastKernel local = kernel;  // the shared functions are non-const members
+    for (std::uint32_t y = rows.begin(); y != rows.end(); ++y) {
+      for (std::uint32_t x = 0; x < mWidth; ++x) {
+        RayHit& ray = mHits[std::size_t(y) * mWidth + x];
+        if (ray.status == kRayPending) ray = local.rcTrace(glm::uvec2(x, y), ray);
+      }
+    }
+  });
+  std::vector<std::uint32_t> requests;
+  for (std::size_t i = 0; i < brickCount; ++i)
+    if (flags[i].load(std::memory_order_relaxed)) requests.push_back(std::uint32_t(i));
+  mLastTraceMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return requests;
+}
+
+}  // namespace flipscope

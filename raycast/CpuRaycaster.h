@@ -1,0 +1,44 @@
+// CpuRaycaster: the C++ reference of the compute ray-caster. It runs raycast/glsl/Raycast.glsl
+// compiled as C++ (see core/GlslShared.h) over a pool held in plain arrays, one TBB task per
+// image row, so tests can compare the GPU's images with it pixel by pixel.
+#pragma once
+
+#include <atomic>
+#include <memory>
+
+#include "raycast/RaycastDevice.h"
+
+namespace flipscope {
+
+class CpuRaycaster : public RaycastDevice {
+ public:
+  std::string name() const override;
+  void allocatePool(const PoolLayout& layout) override;
+  void setOctree(std::span<const OctreeNode> nodes) override;
+  void setPageTable(std::span<const std::uint32_t> pageTable) override;
+  void uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset, const ConvertedBrick& brick) override;
+  void beginImage(std::uint32_t width, std::uint32_t height) override;
+  std::vector<std::uint32_t> trace(const RaycastParams& params) override;
+  double lastTraceMs() const override { return mLastTraceMs; }
+  std::vector<RayHit> readHits() override { return mHits; }
+
+  /// The pool's arrays, laid out as the GPU's buffers (for tests).
+  struct Pool {
+    PoolLayout layout;
+    std::vector<glm::uvec2> nodes;
+    std::vector<std::uint32_t> pageTable;
+    std::vector<glm::uvec4> subBricks;
+    std::vector<std::uint32_t> mipWords;
+    std::vector<std::uint32_t> attributeBases;
+    std::vector<std::uint16_t> attributes;
+  };
+  const Pool& pool() const { return mPool; }
+
+ private:
+  Pool mPool;
+  std::vector<RayHit> mHits;
+  std::uint32_t mWidth = 0, mHeight = 0;
+  double mLastTraceMs = 0;
+};
+
+}  // namespace flipscope

@@ -1,0 +1,239 @@
+#include "raycast/FrameRenderer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <thread>
+#include <unordered_map>
+
+#include <glm/trigonometric.hpp>
+#include <glm/vector_relational.hpp>
+
+#include "core/Error.h"
+#include "streaming/BrickMipmap.h"
+
+namespace flipscope {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+}  // namespace
+
+std::uint32_t sphereReach(float radius, float jitter) {
+  return std::uint32_t(std::ceil(double(radius) + double(jitter) + 0.5) - 1.0);
+}
+
+void validate(const RenderSettings& s) {
+  if (s.width == 0 || s.height == 0 || s.width > 16384 || s.height > 16384)
+    throw InputError("--size: width and height must be in 1..16384, got " + std::to_string(s.width) + "x" +
+                     std::to_string(s.height));
+  if (!(s.radius > 0.0f) || !std::isfinite(s.radius))
+    throw InputError("--radius: must be a positive number of cells, got " + std::to_string(s.radius));
+  if (!(s.jitter >= 0.0f) || !std::isfinite(s.jitter))
+    throw InputError("--jitter: must be 0 or a positive number of cells, got " + std::to_string(s.jitter));
+  if (sphereReach(s.radius, s.jitter) > kMaxOverlap)
+    throw InputError("--radius plus jitter reach " + std::to_string(sphereReach(s.radius, s.jitter)) +
+                     " cells; at most " + std::to_string(kMaxOverlap) + " fit the bit-brick border");
+  if (s.maxPasses < 1) throw InputError("--max-passes: must be at least 1");
+}
+
+namespace {
+StreamerOptions streamerOptions(const BrickStore& store, const RenderSettings& settings, std::uint32_t reach) {
+  StreamerOptions options;
+  options.conversion.brickSize = store.header().brickSize;
+  options.conversion.overlap = reach;
+  options.conversion.attribute =
+      store.header().attribute == AttributeKind::None ? AttributeReduction::None : AttributeReduction::Max;
+  options.mipDilation = reach;
+  options.threads = settings.threads ? settings.threads : std::max(1u, std::thread::hardware_concurrency());
+  options.cacheBytes = settings.cpuCacheBytes;
+  options.readAheadFrames = settings.readAheadFrames;
+  return options;
+}
+
+/// The pool within the budget, shrunk until its largest buffer (the bits) fits the device.
+PoolLayout poolLayout(const BrickStore& store, const RenderSettings& settings, std::uint32_t reach,
+                      std::uint64_t maxBufferBytes) {
+  validate(settings);
+  const bool attributes = store.header().attribute != AttributeKind::None;
+  std::uint64_t budget = settings.gpuBudgetBytes;
+  for (;;) {
+    PoolLayout layout = PoolLayout::forBudget(store.header().brickSize, reach, attributes, budget);
+    const std::uint64_t bits = std::uint64_t(layout.slots) * layout.subBricksPerSlot * 16;
+    const std::uint64_t ring = layout.attributeCapacity * 2;
+    if (bits <= maxBufferBytes && ring <= maxBufferBytes) return layout;
+    budget = budget / 8 * 7;
+  }
+}
+}  // namespace
+
+FrameRenderer::FrameRenderer(BrickStore store, std::unique_ptr<RaycastDevice> device, const RenderSettings& settings)
+    : mStore(std::move(store)),
+      mDevice(std::move(device)),
+      mSettings(settings),
+      mReach(sphereReach(settings.radius, settings.jitter)),
+      mPool(poolLayout(mStore, settings, mReach, mDevice->maxBufferBytes())) {
+  mDevice->allocatePool(mPool.layout());
+  mStreamer =
+      std::make_unique<Streamer>(std::make_shared<StoreBrickSource>(mStore), streamerOptions(mStore, settings, mReach));
+}
+
+FrameRenderer::~FrameRenderer() = default;
+
+Box FrameRenderer::frameBounds(int frame) const {
+  const auto index = mStore.frame(frame);
+  const StoreHeader& h = mStore.header();
+  if (index->bricks.empty()) return {};
+  glm::uvec3 lo(~0u), hi(0u);
+  for (const BrickRecord& record : index->bricks) {
+    lo = glm::min(lo, record.coord);
+    hi = glm::max(hi, record.coord);
+  }
+  // Bricks on the outer layers decide the bounds: decode them (up to a limit) for cell-exact
+  // bounds, so a default camera frames the fluid, not its 64-cell bricks.
+  constexpr std::size_t kMaxDecoded = 2048;
+  std::vector<std::uint32_t> outer;
+  for (std::uint32_t i = 0; i < index->bricks.size(); ++i) {
+    const glm::uvec3 c = index->bricks[i].coord;
+    if (glm::any(glm::equal(c, lo)) || glm::any(glm::equal(c, hi))) outer.push_back(i);
+  }
+  const glm::dvec3 lower(lo * h.brickSize), upper((hi + 1u) * h.brickSize);
+  if (outer.size() > kMaxDecoded) return Box{h.origin + lower * h.cellSize, h.origin + upper * h.cellSize};
+  glm::dvec3 cellMin(std::numeric_limits<double>::infinity()), cellMax(-std::numeric_limits<double>::infinity());
+  for (std::uint32_t i : outer) {
+    const DecodedBrick brick = mStore.readBrick(*index, i);
+    const glm::dvec3 base(index->bricks[i].coord * h.brickSize);
+    for (std::uint32_t cell : brick.cells) {
+      const glm::dvec3 c =
+          base + glm::dvec3(cell % h.brickSize, cell / h.brickSize % h.brickSize, cell / (h.brickSize * h.brickSize));
+      cellMin = glm::min(cellMin, c);
+      cellMax = glm::max(cellMax, c + 1.0);
+    }
+  }
+  return Box{h.origin + cellMin * h.cellSize, h.origin + cellMax * h.cellSize};
+}
+
+RaycastParams FrameRenderer::params(const Camera& camera, const FrameIndex& frame) const {
+  const StoreHeader& h = mStore.header();
+  const PoolLayout& layout = mPool.layout();
+  RaycastParams p{};
+  const glm::dvec3 eye = (camera.eye - h.origin) / h.cellSize;
+  p.eye = glm::vec4(glm::vec3(eye), 0.0f);
+  p.forward = glm::vec4(glm::vec3(camera.forward()), float(std::tan(glm::radians(camera.fovYDegrees) * 0.5)));
+  p.right = glm::vec4(glm::vec3(camera.right()), float(mSettings.width) / float(mSettings.height));
+  p.up = glm::vec4(glm::vec3(camera.trueUp()), float(h.cellSize));
+  p.image = glm::uvec4(mSettings.width, mSettings.height, std::uint32_t(frame.frame), 0);
+  p.grid = glm::uvec4(h.brickGrid, h.brickSize);
+  p.brick = glm::uvec4(mReach, mReach, frame.octree.levels, layout.subBricksPerSlot);
+  p.pool = glm::uvec4(layout.mipWordsPerSlot, layout.attributes ? 1u : 0u, std::uint32_t(frame.bricks.size()),
+                      layout.mipLevels);
+  p.sphere = glm::vec4(mSettings.radius, mSettings.jitter, 0.0f, 0.0f);
+  return p;
+}
+
+std::vector<std::uint32_t> FrameRenderer::pageTable(const FrameIndex& frame) const {
+  std::vector<std::uint32_t> table(frame.bricks.size(), kNotResident);
+  mPool.forEachResident(frame.frame, [&](glm::uvec3 coord, std::uint32_t slot) {
+    const std::int64_t index = frame.octree.find(coord);
+    FLIPSCOPE_CHECK(index >= 0, "a resident brick is not in its frame");
+    table[std::size_t(index)] = slot;
+  });
+  return table;
+}
+
+RenderResult FrameRenderer::render(int frame, const Camera& camera, int direction) {
+  const auto start = Clock::now();
+  validate(camera, "camera");
+  if (!mStore.hasFrame(frame))
+    throw InputError(mStore.directory().string() + ": the store has no frame " + std::to_string(frame));
+  const auto index = mStore.frame(frame);
+  const StoreHeader& header = mStore.header();
+
+  RenderResult result;
+  result.frame = frame;
+  result.width = mSettings.width;
+  result.height = mSettings.height;
+  RenderStats& stats = result.stats;
+  stats.frameBricks = index->bricks.size();
+  stats.poolBytes = mPool.layout().bytes();
+
+  const glm::dvec3 eyeInBricks = (camera.eye - header.origin) / (header.cellSize * header.brickSize);
+  mStreamer->setFrame(frame, direction);
+  mStreamer->setEye(eyeInBricks);
+  std::vector<std::uint32_t> pages = pageTable(*index);
+  mDevice->setOctree(index->octree.nodes);
+  mDevice->setPageTable(pages);
+  mDevice->beginImage(mSettings.width, mSettings.height);
+  const RaycastParams params = this->params(camera, *index);
+
+  std::vector<BrickKey> evicted;
+  for (stats.passes = 1;; ++stats.passes) {
+    const std::vector<std::uint32_t> requests = mDevice->trace(params);
+    stats.traceMs += mDevice->lastTraceMs();
+    if (requests.empty()) {
+      stats.converged = true;
+      break;
+    }
+    if (stats.passes == mSettings.maxPasses) break;
+    stats.bricksRequested += requests.size();
+
+    // Convert (or fetch from the CPU cache) every requested brick.
+    auto streamStart = Clock::now();
+    std::vector<glm::uvec3> coords;
+    std::unordered_map<BrickKey, std::uint32_t, BrickKeyHash> wanted;  // key -> brick index
+    for (std::uint32_t i : requests) {
+      FLIPSCOPE_CHECK(i < index->bricks.size(), "request for brick " << i);
+      coords.push_back(index->bricks[i].coord);
+      wanted.emplace(BrickKey{frame, index->bricks[i].coord}, i);
+    }
+    const std::uint64_t failedBefore = mStreamer->stats().failed;
+    mStreamer->request(coords);
+    std::vector<std::shared_ptr<const ConvertedBrick>> bricks;
+    while (bricks.size() < wanted.size()) {
+      mStreamer->waitIdle();
+      auto ready = mStreamer->takeReady(wanted.size());
+      if (mStreamer->stats().failed > failedBefore) throw FileError(mStore.directory(), mStreamer->lastError());
+      if (ready.empty())
+        throw LogicError("the streamer delivered " + std::to_string(bricks.size()) + " of " +
+                         std::to_string(wanted.size()) + " requested bricks");
+      for (auto& brick : ready)
+        if (wanted.contains(brick->key)) bricks.push_back(std::move(brick));
+    }
+    stats.streamMs += msSince(streamStart);
+
+    // Upload nearest first: when the pool is too small for all, the front of the image goes first.
+    auto uploadStart = Clock::now();
+    auto distance = [&](const ConvertedBrick& b) {
+      const glm::dvec3 d = glm::dvec3(b.key.coord) + 0.5 - eyeInBricks;
+      return glm::dot(d, d);
+    };
+    std::sort(bricks.begin(), bricks.end(), [&](const auto& a, const auto& b) {
+      const double da = distance(*a), db = distance(*b);
+      return da != db ? da < db : wanted.at(a->key) < wanted.at(b->key);
+    });
+    const std::uint64_t batch = ++mBatch;
+    for (const auto& brick : bricks) {
+      evicted.clear();
+      const auto placement = mPool.place(brick->key, brick->bits.attributes.size(), batch, evicted);
+      for (const BrickKey& key : evicted) {
+        ++stats.bricksEvicted;
+        if (key.frame == frame) pages[std::size_t(index->octree.find(key.coord))] = kNotResident;
+      }
+      if (!placement) break;  // the pool holds this pass's bricks only: the rest next pass
+      mDevice->uploadBrick(placement->slot, placement->attributeOffset, *brick);
+      pages[wanted.at(brick->key)] = placement->slot;
+      ++stats.bricksUploaded;
+    }
+    mDevice->setPageTable(pages);
+    stats.uploadMs += msSince(uploadStart);
+  }
+  result.hits = mDevice->readHits();
+  stats.bricksResident = mPool.resident();
+  stats.totalMs = msSince(start);
+  return result;
+}
+
+}  // namespace flipscope

@@ -1,0 +1,96 @@
+// FrameRenderer: the request-driven frame loop (Reichl et al. 2014 §3.3, §4.4). Each pass traces
+// the pending rays; the bricks they stopped at are converted by the Streamer (or found in its
+// CPU cache), placed in the BrickPool and uploaded, and the next pass resumes the rays, until no
+// ray asks for anything. A cold frame converges in a few passes, a warm one in one.
+//
+//   FrameRenderer renderer(BrickStore::open(dir), std::make_unique<CpuRaycaster>(), settings);
+//   RenderResult result = renderer.render(frame, camera);
+//   RenderImage image = shade(result, camera, ShadingOptions{});
+//
+// Not thread safe; one renderer per device.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/Box.h"
+#include "preprocess/BrickStore.h"
+#include "raycast/BrickPool.h"
+#include "raycast/Camera.h"
+#include "raycast/RaycastDevice.h"
+#include "streaming/Streamer.h"
+
+namespace flipscope {
+
+struct RenderSettings {
+  std::uint32_t width = 1280;
+  std::uint32_t height = 720;
+  float radius = 1.0f;   ///< sphere radius in cells
+  float jitter = 0.25f;  ///< largest jitter offset in cells (§3.2.2); 0 turns jitter off
+  std::uint64_t gpuBudgetBytes = std::uint64_t(1) << 30;  ///< brick pool on the device
+  std::uint64_t cpuCacheBytes = std::uint64_t(2) << 30;   ///< converted bricks, all frames
+  unsigned threads = 0;                                   ///< conversion workers; 0: all cores
+  int maxPasses = 1000;
+  int readAheadFrames = 0;
+};
+/// Throws InputError naming the setting that is out of range.
+void validate(const RenderSettings& settings);
+/// Cells around a cell whose spheres can reach it: ceil(radius + jitter + 0.5) - 1.
+std::uint32_t sphereReach(float radius, float jitter);
+
+struct RenderStats {
+  int passes = 0;
+  bool converged = false;             ///< no ray pending at the end (false: pass limit reached)
+  std::uint64_t bricksRequested = 0;  ///< summed over passes
+  std::uint64_t bricksUploaded = 0;
+  std::uint64_t bricksEvicted = 0;
+  std::size_t bricksResident = 0;  ///< in the pool after the frame, all frames
+  std::size_t frameBricks = 0;     ///< non-empty bricks of the frame
+  std::uint64_t poolBytes = 0;     ///< device memory of the brick pool
+  double traceMs = 0;              ///< device time of the passes (GL timer queries on the GPU)
+  double streamMs = 0;             ///< waiting for the Streamer (conversion or CPU cache)
+  double uploadMs = 0;
+  double totalMs = 0;
+};
+
+struct RenderResult {
+  int frame = 0;
+  std::uint32_t width = 0, height = 0;
+  std::vector<RayHit> hits;  ///< row 0 at the top
+  RenderStats stats;
+};
+
+class FrameRenderer {
+ public:
+  FrameRenderer(BrickStore store, std::unique_ptr<RaycastDevice> device, const RenderSettings& settings);
+  ~FrameRenderer();
+
+  /// Renders `frame` (InputError when the store has no such frame). `direction` (+1, -1, 0)
+  /// steers the Streamer's read-ahead.
+  RenderResult render(int frame, const Camera& camera, int direction = 0);
+
+  const BrickStore& store() const { return mStore; }
+  RaycastDevice& device() { return *mDevice; }
+  const RenderSettings& settings() const { return mSettings; }
+  const Streamer& streamer() const { return *mStreamer; }
+  /// World box of the frame's occupied cells (empty box for an empty frame); from the bricks
+  /// alone when more than a few thousand bricks form its outer layers.
+  Box frameBounds(int frame) const;
+  /// The parameter block of a pass (exposed for tests).
+  RaycastParams params(const Camera& camera, const FrameIndex& frame) const;
+
+ private:
+  std::vector<std::uint32_t> pageTable(const FrameIndex& frame) const;
+
+  BrickStore mStore;
+  std::unique_ptr<RaycastDevice> mDevice;
+  RenderSettings mSettings;
+  std::uint32_t mReach = 0;
+  BrickPool mPool;
+  std::unique_ptr<Streamer> mStreamer;
+  std::uint64_t mBatch = 0;
+};
+
+}  // namespace flipscope

@@ -1,0 +1,152 @@
+#include "raycast/GpuRaycaster.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "core/Error.h"
+#include "raycast/CpuRaycaster.h"
+#include "raycast/gl/ShaderSource.h"
+
+namespace flipscope {
+
+namespace {
+// Binding points of raycast/glsl/Raycast.comp.
+enum Binding : GLuint {
+  kParams = 0,
+  kNodes = 1,
+  kPages = 2,
+  kSubBricks = 3,
+  kMips = 4,
+  kAttributeBases = 5,
+  kAttributes = 6,
+  kHits = 7,
+  kRequests = 8,
+  kRequestFlags = 9
+};
+constexpr std::uint32_t kGroupSize = 8;  // local_size_x and _y of Raycast.comp
+
+/// A buffer of at least `bytes` (GL refuses empty storage; unused bindings get 16 bytes).
+gl::Buffer makeBuffer(std::uint64_t bytes, const void* data = nullptr) {
+  return gl::Buffer(std::max<std::uint64_t>(bytes, 16), bytes ? data : nullptr);
+}
+}  // namespace
+
+GpuRaycaster::GpuRaycaster()
+    : mContext(gl::EglContext::create()), mProgram(gl::Program::compute(gl::shaderSource("Raycast.comp"))) {
+  GLint64 maxBlock = 0;
+  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxBlock);
+  mMaxBufferBytes = std::uint64_t(maxBlock);
+  // llvmpipe answers timer queries with ~0: time its passes on the wall clock instead.
+  mWallClockTiming = mContext.renderer().find("llvmpipe") != std::string::npos;
+  mParams = makeBuffer(sizeof(RaycastParams));
+}
+
+GpuRaycaster::~GpuRaycaster() = default;
+
+std::string GpuRaycaster::name() const { return "OpenGL (" + mContext.platform() + "): " + mContext.renderer(); }
+
+void GpuRaycaster::allocatePool(const PoolLayout& layout) {
+  mLayout = layout;
+  mSubBricks = makeBuffer(std::uint64_t(layout.slots) * layout.subBricksPerSlot * 16);
+  mMips = makeBuffer(std::uint64_t(layout.slots) * layout.mipWordsPerSlot * 4);
+  mAttributeBases = makeBuffer(layout.attributes ? std::uint64_t(layout.slots) * layout.subBricksPerSlot * 4 : 0);
+  mAttributes = makeBuffer(layout.attributeCapacity * 2);
+}
+
+void GpuRaycaster::setOctree(std::span<const OctreeNode> nodes) {
+  mNodes = makeBuffer(nodes.size_bytes(), nodes.data());
+}
+
+void GpuRaycaster::setPageTable(std::span<const std::uint32_t> pageTable) {
+  if (pageTable.size() != mBricks || mPages.size() < std::max<std::size_t>(pageTable.size_bytes(), 16)) {
+    mBricks = pageTable.size();
+    mPages = makeBuffer(pageTable.size_bytes(), pageTable.data());
+    mRequests = makeBuffer(4 + pageTable.size_bytes());  // count, then up to one entry per brick
+    mRequestFlags = makeBuffer(pageTable.size_bytes());
+    return;
+  }
+  if (!pageTable.empty()) mPages.upload(0, pageTable.data(), pageTable.size_bytes());
+}
+
+void GpuRaycaster::uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset, const ConvertedBrick& brick) {
+  FLIPSCOPE_CHECK(slot < mLayout.slots && brick.bits.subBricks.size() == mLayout.subBricksPerSlot &&
+                  brick.mipmap.size() == mLayout.mipWordsPerSlot);
+  mSubBricks.upload(std::uint64_t(slot) * mLayout.subBricksPerSlot * 16, brick.bits.subBricks.data(),
+                    brick.bits.subBricks.size() * 16);
+  mMips.upload(std::uint64_t(slot) * mLayout.mipWordsPerSlot * 4, brick.mipmap.data(), brick.mipmap.size() * 4);
+  if (mLayout.attributes) {
+    const auto bases = attributeBases(brick.bits, attributeOffset);
+    mAttributeBases.upload(std::uint64_t(slot) * mLayout.subBricksPerSlot * 4, bases.data(), bases.size() * 4);
+    if (!brick.bits.attributes.empty())
+      mAttributes.upload(attributeOffset * 2, brick.bits.attributes.data(), brick.bits.attributes.size() * 2);
+  }
+}
+
+void GpuRaycaster::beginImage(std::uint32_t width, std::uint32_t height) {
+  mWidth = width;
+  mHeight = height;
+  RayHit pending{};
+  pending.status = kRayPending;
+  pending.brickIndex = kNotResident;
+  const std::vector<RayHit> rays(std::size_t(width) * height, pending);
+  if (mHits.size() != rays.size() * sizeof(RayHit)) {
+    mHits = makeBuffer(rays.size() * sizeof(RayHit), rays.data());
+  } else {
+    mHits.upload(0, rays.data(), rays.size() * sizeof(RayHit));
+  }
+}
+
+std::vector<std::uint32_t> GpuRaycaster::trace(const RaycastParams& params) {
+  FLIPSCOPE_CHECK(params.image.x == mWidth && params.image.y == mHeight);
+  mParams.upload(0, &params, sizeof(params));
+  const std::uint32_t zero = 0;
+  mRequests.upload(0, &zero, 4);
+  mRequestFlags.clearZero();
+  mParams.bindBase(GL_UNIFORM_BUFFER, kParams);
+  mNodes.bindBase(GL_SHADER_STORAGE_BUFFER, kNodes);
+  mPages.bindBase(GL_SHADER_STORAGE_BUFFER, kPages);
+  mSubBricks.bindBase(GL_SHADER_STORAGE_BUFFER, kSubBricks);
+  mMips.bindBase(GL_SHADER_STORAGE_BUFFER, kMips);
+  mAttributeBases.bindBase(GL_SHADER_STORAGE_BUFFER, kAttributeBases);
+  mAttributes.bindBase(GL_SHADER_STORAGE_BUFFER, kAttributes);
+  mHits.bindBase(GL_SHADER_STORAGE_BUFFER, kHits);
+  mRequests.bindBase(GL_SHADER_STORAGE_BUFFER, kRequests);
+  mRequestFlags.bindBase(GL_SHADER_STORAGE_BUFFER, kRequestFlags);
+  mProgram.use();
+  const auto start = std::chrono::steady_clock::now();
+  mTimer.begin();
+  mProgram.dispatch((mWidth + kGroupSize - 1) / kGroupSize, (mHeight + kGroupSize - 1) / kGroupSize, 1);
+  mTimer.end();
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+  std::uint32_t count = 0;
+  mRequests.download(0, 4, &count);
+  count = std::min<std::uint32_t>(count, std::uint32_t(mBricks));
+  std::vector<std::uint32_t> requests(count);
+  if (count) mRequests.download(4, count * 4, requests.data());
+  std::sort(requests.begin(), requests.end());
+  requests.erase(std::unique(requests.begin(), requests.end()), requests.end());
+  mLastTraceMs = mWallClockTiming
+                     ? std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()
+                     : mTimer.milliseconds();
+  return requests;
+}
+
+std::vector<RayHit> GpuRaycaster::readHits() {
+  std::vector<RayHit> hits(std::size_t(mWidth) * mHeight);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  mHits.download(0, hits.size() * sizeof(RayHit), hits.data());
+  return hits;
+}
+
+std::unique_ptr<RaycastDevice> createRaycastDevice(DeviceChoice choice, std::string* fallbackReason) {
+  if (choice == DeviceChoice::Cpu) return std::make_unique<CpuRaycaster>();
+  try {
+    return std::make_unique<GpuRaycaster>();
+  } catch (const gl::Unavailable& e) {
+    if (choice == DeviceChoice::Gpu) throw;
+    if (fallbackReason) *fallbackReason = e.what();
+    return std::make_unique<CpuRaycaster>();
+  }
+}
+
+}  // namespace flipscope

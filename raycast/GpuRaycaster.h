@@ -1,0 +1,52 @@
+// GpuRaycaster: the compute ray-caster on OpenGL 4.5 (raycast/glsl/Raycast.comp) with its brick
+// pool in shader storage buffers (Reichl et al. 2014 §3.3, §4.1). Headless through EGL: the
+// NVIDIA device platform on GPU machines, Mesa (llvmpipe) elsewhere.
+#pragma once
+
+#include <memory>
+
+#include "raycast/RaycastDevice.h"
+#include "raycast/gl/EglContext.h"
+#include "raycast/gl/Objects.h"
+
+namespace flipscope {
+
+class GpuRaycaster : public RaycastDevice {
+ public:
+  /// Creates the context and compiles the shader. Throws gl::Unavailable without a usable
+  /// EGL/OpenGL 4.5 device.
+  GpuRaycaster();
+  ~GpuRaycaster() override;
+
+  std::string name() const override;
+  std::uint64_t maxBufferBytes() const override { return mMaxBufferBytes; }
+  void allocatePool(const PoolLayout& layout) override;
+  void setOctree(std::span<const OctreeNode> nodes) override;
+  void setPageTable(std::span<const std::uint32_t> pageTable) override;
+  void uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset, const ConvertedBrick& brick) override;
+  void beginImage(std::uint32_t width, std::uint32_t height) override;
+  std::vector<std::uint32_t> trace(const RaycastParams& params) override;
+  double lastTraceMs() const override { return mLastTraceMs; }
+  std::vector<RayHit> readHits() override;
+
+ private:
+  gl::EglContext mContext;
+  gl::Program mProgram;
+  gl::TimerQuery mTimer;
+  std::uint64_t mMaxBufferBytes = 0;
+  PoolLayout mLayout;
+  std::uint32_t mWidth = 0, mHeight = 0;
+  std::size_t mBricks = 0;  ///< bricks of the current frame (page table entries)
+  gl::Buffer mParams, mNodes, mPages, mSubBricks, mMips, mAttributeBases, mAttributes, mHits, mRequests, mRequestFlags;
+  double mLastTraceMs = 0;
+  bool mWallClockTiming = false;  ///< software rasterizer: timer queries are meaningless
+};
+
+enum class DeviceChoice { Auto, Gpu, Cpu };
+
+/// The device a command asked for: Gpu (throws gl::Unavailable without one), Cpu (the reference
+/// ray-caster), or Auto (OpenGL when EGL gives a context, else the CPU reference; `fallbackReason`
+/// then says why).
+std::unique_ptr<RaycastDevice> createRaycastDevice(DeviceChoice choice, std::string* fallbackReason = nullptr);
+
+}  // namespace flipscope

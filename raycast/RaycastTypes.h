@@ -1,0 +1,27 @@
+// C++ side of raycast/glsl/RaycastTypes.glsl: the ray-caster's parameter block and per-pixel
+// result, defined once for C++ and GLSL, with their GPU layouts checked here.
+#pragma once
+
+#include <cstddef>
+
+#include "core/GlslShared.h"
+
+namespace flipscope::glsl {
+#include "raycast/glsl/RaycastTypes.glsl"
+}  // namespace flipscope::glsl
+
+namespace flipscope {
+using glsl::kNotResident;
+using glsl::kRayHit;
+using glsl::kRayMiss;
+using glsl::kRayPending;
+using glsl::RaycastParams;
+using glsl::RayHit;
+
+// std140 and std430 agree with C++ for these members (16-byte vectors, then 4-byte scalars).
+static_assert(sizeof(RaycastParams) == 9 * 16);
+static_assert(offsetof(RaycastParams, image) == 64 && offsetof(RaycastParams, sphere) == 128);
+static_assert(sizeof(RayHit) == 32);
+static_assert(offsetof(RayHit, t) == 16 && offsetof(RayHit, status) == 20 && offsetof(RayHit, depth) == 24 &&
+              offsetof(RayHit, brickIndex) == 28);
+}  // namespace flipscope

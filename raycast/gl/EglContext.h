@@ -1,0 +1,61 @@
+// EglContext: a headless OpenGL 4.5 core context through EGL (no window, no X server), made
+// current on the creating thread with no surface (EGL_KHR_surfaceless_context). GL entry points
+// come from libepoxy. Displays are tried in this order:
+//  1. "device": the EGL device platform (EGL_EXT_platform_device), hardware devices first
+//     (NVIDIA's EGL_NV_device_cuda, then any device with a DRM node);
+//  2. "surfaceless": Mesa's EGL_PLATFORM_SURFACELESS_MESA (llvmpipe when there is no GPU);
+//  3. "default": eglGetDisplay(EGL_DEFAULT_DISPLAY);
+//  4. "device" again with software devices (EGL_MESA_device_software).
+// Builds with FLIPSCOPE_GL_DEBUG create a debug context and print GL errors and warnings to
+// stderr. Not thread safe; GL objects (raycast/gl/Objects.h) must be destroyed while their
+// context is alive and current.
+#pragma once
+
+#include <epoxy/egl.h>
+
+#include <stdexcept>
+#include <string>
+
+namespace flipscope::gl {
+
+/// No usable EGL display or OpenGL 4.5 context; what() names the step that failed and the EGL
+/// error, for every display tried.
+class Unavailable : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class EglContext {
+ public:
+  /// Creates the context and makes it current on this thread. Throws Unavailable.
+  static EglContext create();
+
+  EglContext() = default;  ///< empty: no display, no context
+  ~EglContext();
+  EglContext(EglContext&& other) noexcept;
+  EglContext& operator=(EglContext&& other) noexcept;
+  EglContext(const EglContext&) = delete;
+  EglContext& operator=(const EglContext&) = delete;
+
+  /// Makes this context current on the calling thread (create() already did for its thread).
+  void makeCurrent() const;
+  /// "GL_VENDOR / GL_RENDERER / GL_VERSION" on one line; the context must be current.
+  std::string renderer() const;
+  /// Which display was used: "device", "surfaceless" or "default".
+  const std::string& platform() const { return mPlatform; }
+  bool isValid() const { return mContext != EGL_NO_CONTEXT; }
+  EGLDisplay display() const { return mDisplay; }
+  EGLContext context() const { return mContext; }
+
+ private:
+  void reset() noexcept;
+
+  EGLDisplay mDisplay = EGL_NO_DISPLAY;
+  EGLContext mContext = EGL_NO_CONTEXT;
+  std::string mPlatform;
+};
+
+/// Name of an EGL error code ("EGL_BAD_MATCH"), or its hex value when unknown.
+std::string eglErrorName(EGLint error);
+
+}  // namespace flipscope::gl

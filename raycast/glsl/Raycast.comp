@@ -1,0 +1,47 @@
+// The compute ray-caster (Reichl et al. 2014 §3.3): one invocation per pixel continues its
+// pending ray through raycast/glsl/Raycast.glsl. Buffers are bound by raycast/GpuRaycaster.cpp
+// at the binding points below; every array is laid out as CpuRaycaster::Pool describes.
+layout(local_size_x = 8, local_size_y = 8) in;
+
+#include "Morton.glsl"
+#include "Jitter.glsl"
+#include "BitBrick.glsl"
+#include "RaycastTypes.glsl"
+
+layout(std140, binding = 0) uniform ParamsBlock { RaycastParams P; };
+layout(std430, binding = 1) readonly buffer NodeBuffer { uvec2 nodes[]; };
+layout(std430, binding = 2) readonly buffer PageBuffer { uint pages[]; };
+layout(std430, binding = 3) readonly buffer SubBrickBuffer { uvec4 subBricks[]; };
+layout(std430, binding = 4) readonly buffer MipBuffer { uint mipWords[]; };
+layout(std430, binding = 5) readonly buffer AttributeBaseBuffer { uint attributeBases[]; };
+layout(std430, binding = 6) readonly buffer AttributeBuffer { uint attributePairs[]; };  // two uint16 per uint
+layout(std430, binding = 7) buffer HitBuffer { RayHit hits[]; };
+layout(std430, binding = 8) buffer RequestBuffer { uint requestCount; uint requests[]; };
+layout(std430, binding = 9) buffer RequestFlagBuffer { uint requestFlags[]; };  // one per brick, cleared per pass
+
+uvec2 rcNode(uint node) { return nodes[node]; }
+uint rcPage(uint brickIndex) { return pages[brickIndex]; }
+uvec4 rcSubBrick(uint slot, uint subBrick) { return subBricks[slot * P.brick.w + subBrick]; }
+uint rcMipWord(uint slot, uint word) { return mipWords[slot * P.pool.x + word]; }
+uint rcAttributeBase(uint slot, uint subBrick) { return attributeBases[slot * P.brick.w + subBrick]; }
+uint rcAttribute(uint index) { return (attributePairs[index >> 1u] >> ((index & 1u) * 16u)) & 0xffffu; }
+
+// The request buffer (§3.3): a brick is appended once per pass; overflow is dropped (the ray
+// stays pending and asks again next pass).
+void rcRequest(uint brickIndex) {
+  if (atomicExchange(requestFlags[brickIndex], 1u) == 0u) {
+    uint slot = atomicAdd(requestCount, 1u);
+    if (slot < uint(requests.length())) requests[slot] = brickIndex;
+  }
+}
+
+#include "Raycast.glsl"
+
+void main() {
+  uvec2 pixel = gl_GlobalInvocationID.xy;
+  if (pixel.x >= P.image.x || pixel.y >= P.image.y) return;
+  uint index = pixel.y * P.image.x + pixel.x;
+  RayHit ray = hits[index];
+  if (ray.status != kRayPending) return;
+  hits[index] = rcTrace(pixel, ray);
+}

@@ -1,0 +1,225 @@
+// Sphere ray casting through the presence octree and bit-bricks (Reichl et al. 2014 §3.3,
+// §3.3.1, §4.2), shared by the compute shader (raycast/glsl/Raycast.comp) and the CPU reference
+// (raycast/CpuRaycaster.cpp); see core/GlslShared.h for the rules. Needs Morton.glsl,
+// Jitter.glsl, BitBrick.glsl and RaycastTypes.glsl before it, a RaycastParams named P, and
+// these accessors from the includer:
+//   uvec2 rcNode(uint node)                       presence octree node (childMask, firstChild)
+//   uint  rcPage(uint brickIndex)                 pool slot of a brick of the frame, or kNotResident
+//   uvec4 rcSubBrick(uint slot, uint subBrick)    bits of a resident brick
+//   uint  rcMipWord(uint slot, uint word)         its occupancy mipmap (BrickMipmap.h layout)
+//   uint  rcAttributeBase(uint slot, uint subBrick)  attribute index of the sub-brick's first set cell
+//   uint  rcAttribute(uint index)                 16-bit attribute value
+//   void  rcRequest(uint brickIndex)              asks for a brick (deduplicated by the includer)
+//
+// Model. Every set cell of a bit-brick holds one sphere of radius P.sphere.x cells centred at the
+// cell centre plus the cell's jitter (§3.2.2). A sphere reaches cells at most k = P.brick.y away
+// (k >= radius + jitter - 0.5), so the overlap border (n >= k) lets a brick alone answer for any
+// ray segment inside it, and a mip block whose bit is clear (dilation >= k) holds no sphere.
+//
+// Traversal, front to back, by point location (no DDA state to carry across passes):
+//  1. the brick containing the ray's point is found by descending the octree; an empty octant is
+//     skipped to its exit;
+//  2. a brick that is not resident is requested and the ray stops (kRayPending, resumes at t);
+//  3. inside a brick, the coarsest clear mip block around the point is skipped to its exit;
+//     otherwise the spheres of the (2k+1)^3 cells around the point's cell are tested, and the
+//     nearest hit no farther than the cell's exit ends the ray (a nearer hit would have been
+//     found in an earlier cell).
+
+// A small step past a box exit, so that point location lands in the next box.
+FS_FUNC float rcStepPast(float t) { return t + 1.0e-3f + abs(t) * 4.0e-7f; }
+
+FS_FUNC vec3 rcSafeInverse(vec3 d) {
+  vec3 safe = d;
+  for (int a = 0; a < 3; a++) {
+    if (abs(safe[a]) < 1.0e-12f) safe[a] = safe[a] < 0.0f ? -1.0e-12f : 1.0e-12f;
+  }
+  return vec3(1.0f) / safe;
+}
+
+// Entry and exit distances of the ray o + t d (invDir = 1 / d) through the box [lo, hi].
+FS_FUNC vec2 rcBoxSpan(vec3 o, vec3 invDir, vec3 lo, vec3 hi) {
+  vec3 t1 = (lo - o) * invDir;
+  vec3 t2 = (hi - o) * invDir;
+  vec3 tn = min(t1, t2);
+  vec3 tf = max(t1, t2);
+  return vec2(max(max(tn.x, tn.y), tn.z), min(min(tf.x, tf.y), tf.z));
+}
+
+// Unit direction of the ray through the centre of `pixel` (row 0 at the top).
+FS_FUNC vec3 rcCameraRay(uvec2 pixel) {
+  float sx = ((float(pixel.x) + 0.5f) / float(P.image.x) * 2.0f - 1.0f) * P.forward.w * P.right.w;
+  float sy = (1.0f - (float(pixel.y) + 0.5f) / float(P.image.y) * 2.0f) * P.forward.w;
+  vec3 f = vec3(P.forward.x, P.forward.y, P.forward.z);
+  vec3 r = vec3(P.right.x, P.right.y, P.right.z);
+  vec3 u = vec3(P.up.x, P.up.y, P.up.z);
+  return normalize(f + sx * r + sy * u);
+}
+
+FS_FUNC bool rcCellSet(uint slot, ivec3 cell) {
+  uint overlap = P.brick.x;
+  uint brickSize = P.grid.w;
+  uvec4 bits = rcSubBrick(slot, bitBrickSubBrickIndex(cell, brickSize, overlap));
+  return bitBrickBitSet(bits, bitBrickBitIndex(cell, overlap));
+}
+
+FS_FUNC float rcCellAttribute(uint slot, ivec3 cell) {
+  if (P.pool.y == 0u) return 0.0f;
+  uint overlap = P.brick.x;
+  uint subBrick = bitBrickSubBrickIndex(cell, P.grid.w, overlap);
+  uvec4 bits = rcSubBrick(slot, subBrick);
+  uint index = bitBrickAttributeOffset(rcAttributeBase(slot, subBrick), bits, bitBrickBitIndex(cell, overlap));
+  return float(rcAttribute(index)) / 65535.0f;
+}
+
+// Whether the mip block of `level` around brick-local `cell` is clear (holds no sphere).
+FS_FUNC bool rcMipClear(uint slot, uint level, ivec3 cell) {
+  uint overlap = P.brick.x;
+  uint brickSize = P.grid.w;
+  uvec3 s = uvec3(cell + ivec3(int(overlap)));
+  uvec3 block = uvec3(s.x >> (level + 1u), s.y >> (level + 1u), s.z >> (level + 2u));
+  uint bit = bitBrickMipBitIndex(block, level, brickSize, overlap);
+  uint word = rcMipWord(slot, bitBrickMipWordOffset(level, brickSize, overlap) + (bit >> 5u));
+  return ((word >> (bit & 31u)) & 1u) == 0u;
+}
+
+// Traces the segment [t, tEnd] of the ray through resident brick `brick` (at `slot`). Returns a
+// hit in `result` (status kRayHit) or leaves result.status pending.
+FS_FUNC RayHit rcTraceBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t, float tEnd) {
+  int B = int(P.grid.w);
+  int k = int(P.brick.y);
+  uint levels = P.pool.w;
+  float radius = P.sphere.x;
+  float jitter = P.sphere.y;
+  vec3 brickOrigin = vec3(brick * uvec3(uint(B)));
+  vec3 o = eye - brickOrigin;  // ray origin in brick-local cells
+  vec3 invDir = rcSafeInverse(dir);
+  for (uint step = 0u; step < kRaycastMaxSteps; step++) {
+    if (t > tEnd) return result;
+    vec3 p = o + t * dir;
+    ivec3 cell = clamp(ivec3(floor(p)), ivec3(0), ivec3(B - 1));
+    // Empty-space skipping (§4.2): the coarsest clear block around the cell.
+    bool skipped = false;
+    for (uint level = levels; level >= 1u && !skipped; level--) {
+      if (rcMipClear(slot, level, cell)) {
+        int overlap = int(P.brick.x);
+        ivec3 size = ivec3(2 << level, 2 << level, 4 << level);
+        ivec3 s = cell + ivec3(overlap);
+        ivec3 lo = ivec3((s.x / size.x) * size.x, (s.y / size.y) * size.y, (s.z / size.z) * size.z) - ivec3(overlap);
+        t = rcStepPast(rcBoxSpan(o, invDir, vec3(lo), vec3(lo + size)).y);
+        skipped = true;
+      }
+    }
+    if (skipped) continue;
+    // §3.3.1: ray-sphere tests against the jittered centres of the cells around this one.
+    float best = 3.0e38f;
+    ivec3 bestCell = ivec3(0);
+    vec3 bestCentre = vec3(0.0f);
+    for (int dz = -k; dz <= k; dz++) {
+      for (int dy = -k; dy <= k; dy++) {
+        for (int dx = -k; dx <= k; dx++) {
+          ivec3 q = cell + ivec3(dx, dy, dz);
+          if (!rcCellSet(slot, q)) continue;
+          vec3 centre = vec3(q) + vec3(0.5f);
+          if (jitter > 0.0f) {
+            uvec3 global = uvec3(ivec3(brick * uvec3(uint(B))) + q);
+            centre += cellJitter(global, P.image.z, jitter);
+          }
+          // Solved from the ray's current point p, not its origin: p is within a few cells of
+          // the centre, so b * b - c does not cancel catastrophically far from the camera.
+          vec3 oc = p - centre;
+          float b = dot(oc, dir);
+          float c = dot(oc, oc) - radius * radius;
+          float disc = b * b - c;
+          if (disc < 0.0f) continue;
+          float tHit = t + (-b - sqrt(disc));
+          if (tHit >= 0.0f && tHit < best) {
+            best = tHit;
+            bestCell = q;
+            bestCentre = centre;
+          }
+        }
+      }
+    }
+    float cellExit = rcBoxSpan(o, invDir, vec3(cell), vec3(cell + ivec3(1))).y;
+    if (best <= cellExit) {
+      vec3 n = (o + best * dir - bestCentre) / radius;
+      result.normal = vec4(normalize(n), rcCellAttribute(slot, bestCell));
+      result.t = best;
+      result.status = kRayHit;
+      return result;
+    }
+    t = rcStepPast(cellExit);
+  }
+  return result;
+}
+
+// Continues `ray` (pending, from ray.t) for `pixel` until it hits, misses, or stops at a brick
+// that is not resident (then requested). A ray that exhausts kRaycastMaxSteps is a miss.
+FS_FUNC RayHit rcTrace(uvec2 pixel, RayHit ray) {
+  RayHit result = ray;
+  vec3 eye = vec3(P.eye.x, P.eye.y, P.eye.z);
+  vec3 dir = rcCameraRay(pixel);
+  vec3 invDir = rcSafeInverse(dir);
+  uint B = P.grid.w;
+  vec3 gridCells = vec3(uvec3(P.grid.x, P.grid.y, P.grid.z) * uvec3(B));
+  vec2 domain = rcBoxSpan(eye, invDir, vec3(0.0f), gridCells);
+  result.status = kRayMiss;
+  result.brickIndex = kNotResident;
+  result.depth = 0.0f;
+  result.t = 0.0f;  // a miss carries no distance
+  if (P.pool.z == 0u || domain.x > domain.y || domain.y < 0.0f) return result;
+  float t = max(max(ray.t, domain.x), 0.0f);
+  uint levels = P.brick.z;
+  for (uint step = 0u; step < kRaycastMaxSteps; step++) {
+    if (t > domain.y) return result;
+    vec3 p = eye + t * dir;
+    uvec3 brick = uvec3(clamp(ivec3(floor(p / float(B))), ivec3(0), ivec3(P.grid.x, P.grid.y, P.grid.z) - ivec3(1)));
+    // 1. Descend the presence octree to the brick, or to the empty octant holding the point.
+    uint node = 0u;
+    uvec3 origin = uvec3(0u);
+    uint brickIndex = kNotResident;
+    float emptyExit = -1.0f;
+    for (uint level = 0u; level < levels; level++) {
+      uint halfSize = 1u << (levels - 1u - level);
+      uvec3 octant = uvec3(brick.x - origin.x >= halfSize ? 1u : 0u, brick.y - origin.y >= halfSize ? 1u : 0u,
+                           brick.z - origin.z >= halfSize ? 1u : 0u);
+      uint child = octant.x | (octant.y << 1u) | (octant.z << 2u);
+      uvec2 n = rcNode(node);
+      origin += octant * uvec3(halfSize);
+      if (((n.x >> child) & 1u) == 0u) {
+        vec3 lo = vec3(origin * uvec3(B));
+        emptyExit = rcBoxSpan(eye, invDir, lo, lo + vec3(float(halfSize * B))).y;
+        break;
+      }
+      uint index = n.y + uint(bitCount(n.x & ((1u << child) - 1u)));
+      if (level + 1u == levels) brickIndex = index;
+      node = index;
+    }
+    if (brickIndex == kNotResident) {
+      t = rcStepPast(max(emptyExit, t));
+      continue;
+    }
+    // 2. Stop at a brick that is not resident.
+    uint slot = rcPage(brickIndex);
+    if (slot == kNotResident) {
+      rcRequest(brickIndex);
+      result.t = t;
+      result.status = kRayPending;
+      result.brickIndex = brickIndex;
+      return result;
+    }
+    // 3. March the brick.
+    vec3 lo = vec3(brick * uvec3(B));
+    float brickExit = rcBoxSpan(eye, invDir, lo, lo + vec3(float(B))).y;
+    result.status = kRayPending;
+    result = rcTraceBrick(result, slot, brick, eye, dir, t, brickExit);
+    if (result.status == kRayHit) {
+      result.brickIndex = brickIndex;
+      result.depth = result.t * P.up.w * dot(dir, vec3(P.forward.x, P.forward.y, P.forward.z));
+      return result;
+    }
+    result.status = kRayMiss;
+    t = rcStepPast(max(brickExit, t));
+  }
+  return result;
+}

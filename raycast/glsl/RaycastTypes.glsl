@@ -1,0 +1,37 @@
+// Structs the CPU fills and the ray-caster reads, shared by C++ (raycast/RaycastTypes.h, which
+// checks every offset) and GLSL; see core/GlslShared.h for the rules. RaycastParams is a std140
+// uniform block, RayHit a std430 array element: only 16-byte vectors and scalars in groups of
+// four, so both layouts equal the C++ one.
+//
+// Units. The ray-caster works in grid cells: cell (i,j,k) spans [i, i+1) x ... and brick b spans
+// cells [b*B, b*B + B). Grid and world axes are parallel (world = origin + cells * cellSize), so
+// directions and normals are the same in both.
+
+struct RaycastParams {
+  vec4 eye;      // xyz: eye in grid cells
+  vec4 forward;  // xyz: unit view direction; w: tan(vertical fov / 2)
+  vec4 right;    // xyz: unit right vector; w: width / height
+  vec4 up;       // xyz: unit up vector; w: cell size in world units (depth output)
+  uvec4 image;   // x, y: width, height in pixels; z: time step (jitter seed); w: unused
+  uvec4 grid;    // xyz: bricks per axis; w: cells per brick edge B
+  uvec4 brick;   // x: overlap n; y: neighbourhood k; z: octree levels; w: sub-bricks per slot
+  uvec4 pool;    // x: mip words per slot; y: 1 with attributes; z: bricks in the frame; w: mip levels
+  vec4 sphere;   // x: radius in cells; y: max jitter in cells; z, w: unused
+};
+
+// One pixel's ray. While pending, t is where the ray resumes (it stopped at a brick that was not
+// resident); once hit, t is the hit distance in cells.
+const uint kRayPending = 0u;
+const uint kRayHit = 1u;
+const uint kRayMiss = 2u;
+
+struct RayHit {
+  vec4 normal;     // xyz: unit sphere normal at the hit; w: attribute in [0, 1] (0 without)
+  float t;         // cells along the unit ray direction
+  uint status;     // kRayPending, kRayHit or kRayMiss
+  float depth;     // linear camera depth in world units (t * cellSize * dot(dir, forward))
+  uint brickIndex; // brick of the hit, or the brick the pending ray waits for
+};
+
+const uint kNotResident = 0xffffffffu;
+const uint kRaycastMaxSteps = 65536u;  // bound on each traversal loop of one ray in one pass

@@ -1,0 +1,201 @@
+// The CPU reference ray-caster and the frame loop: a ball renders as a disk with the analytic
+// depth; the traversal (octree, bricks, mip skipping) finds the same nearest spheres as a brute
+// force over every particle's sphere; cold equals warm; a tiny pool converges by eviction.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <set>
+#include <sstream>
+
+#include "RaycastScenes.h"
+#include "TestSupport.h"
+#include "core/Error.h"
+#include "raycast/CpuRaycaster.h"
+#include "streaming/Jitter.h"
+
+namespace flipscope {
+namespace {
+
+// The first pixel where two images differ, for failure messages.
+std::string firstDifference(const std::vector<RayHit>& a, const std::vector<RayHit>& b) {
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (std::memcmp(&a[i], &b[i], sizeof(RayHit)) == 0) continue;
+    std::ostringstream os;
+    os << "pixel " << i << ": status " << a[i].status << "/" << b[i].status << " t " << a[i].t << "/" << b[i].t
+       << " depth " << a[i].depth << "/" << b[i].depth << " brick " << a[i].brickIndex << "/" << b[i].brickIndex
+       << " normal.w " << a[i].normal.w << "/" << b[i].normal.w;
+    return os.str();
+  }
+  return "identical";
+}
+
+using testing::TempDir;
+
+std::unique_ptr<FrameRenderer> cpuRenderer(const BrickStore& store, const RenderSettings& settings) {
+  return std::make_unique<FrameRenderer>(store, std::make_unique<CpuRaycaster>(), settings);
+}
+
+glm::dvec3 pixelRay(const Camera& camera, const RenderSettings& s, std::uint32_t x, std::uint32_t y) {
+  return camera.pixelRay(x, y, s.width, s.height);
+}
+
+TEST(CpuRaycaster, BallRendersAsDiskWithAnalyticDepth) {
+  TempDir dir("ball");
+  const testing::BallScene ball;
+  BrickStore store = ball.makeStore(dir / "store");
+  auto renderer = cpuRenderer(store, ball.settings());
+  const RenderResult result = renderer->render(0, ball.camera());
+  ASSERT_TRUE(result.stats.converged);
+  ball.expectDiskWithAnalyticDepth(result);
+}
+
+// Brute force over every set cell's sphere: the nearest hit distance in cells.
+struct BruteForce {
+  std::vector<glm::vec3> centres;
+  float radius;
+  float nearest(glm::vec3 eye, glm::vec3 dir) const {
+    float best = -1;
+    for (const glm::vec3& c : centres) {
+      const glm::vec3 oc = eye - c;
+      const float b = glm::dot(oc, dir), disc = b * b - (glm::dot(oc, oc) - radius * radius);
+      if (disc < 0) continue;
+      const float t = -b - std::sqrt(disc);
+      if (t >= 0 && (best < 0 || t < best)) best = t;
+    }
+    return best;
+  }
+};
+
+class CpuRaycasterScenes : public ::testing::TestWithParam<int> {};
+
+TEST_P(CpuRaycasterScenes, FindsTheNearestSphereOfABruteForce) {
+  const int seed = GetParam();
+  TempDir dir("cloud");
+  const float extent = 80.0f;
+  const auto particles = testing::cloudParticles(6000, std::uint32_t(seed), extent);
+  BrickStore store = testing::makeStore(dir / "store", {particles}, extent, 32);
+  RenderSettings settings = testing::smallSettings(96, 64);
+  settings.radius = seed % 2 ? 1.4f : 0.9f;
+  settings.jitter = seed % 3 ? 0.3f : 0.0f;
+  auto renderer = cpuRenderer(store, settings);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> angle(0, 6.283);
+  Camera camera = frameOnBox(Box{{0, 0, 0}, {extent, extent, extent}}, 1.5);
+  const double a = angle(rng);
+  camera.eye = camera.target + glm::dvec3(std::cos(a), 0.6, std::sin(a)) * 110.0;
+  const RenderResult result = renderer->render(0, camera);
+  ASSERT_TRUE(result.stats.converged);
+
+  // The oracle's spheres: every occupied cell, jittered like the shader (frame 0).
+  BruteForce oracle{{}, settings.radius};
+  std::set<std::tuple<int, int, int>> cells;
+  for (const glm::vec3& p : particles) cells.insert({int(p.x), int(p.y), int(p.z)});
+  for (auto [x, y, z] : cells) {
+    glm::vec3 c = glm::vec3(x, y, z) + 0.5f;
+    if (settings.jitter > 0) c += cellJitter(glm::uvec3(x, y, z), 0, settings.jitter);
+    oracle.centres.push_back(c);
+  }
+  int both = 0, agree = 0, mismatch = 0;
+  for (std::uint32_t y = 0; y < settings.height; ++y) {
+    for (std::uint32_t x = 0; x < settings.width; ++x) {
+      const RayHit& hit = result.hits[y * settings.width + x];
+      const glm::vec3 dir(pixelRay(camera, settings, x, y));
+      const float expected = oracle.nearest(glm::vec3(camera.eye), dir);
+      if ((expected >= 0) != (hit.status == kRayHit)) {
+        ++mismatch;
+        continue;
+      }
+      if (expected < 0) continue;
+      ++both;
+      agree += std::abs(hit.t - expected) < 2e-3f * std::max(1.0f, expected);
+    }
+  }
+  // Rays grazing an empty brick can miss spheres that reach into it from a brick they never
+  // enter (Raycast.glsl: at most k cells at brick faces): a few silhouette pixels.
+  EXPECT_GT(both, 200);
+  EXPECT_LE(mismatch, int(settings.width * settings.height) / 100) << "hit/miss disagreements";
+  EXPECT_GE(agree, both - both / 100) << "of " << both << " pixels hit on both sides";
+}
+
+INSTANTIATE_TEST_SUITE_P(RandomScenes, CpuRaycasterScenes, ::testing::Values(1, 2, 3, 4));
+
+TEST(CpuRaycaster, HitsCarryTheirCellsAttribute) {
+  // Two balls: the left one slow, the right one fast; speeds quantize to 0 and 65535 (§3.2).
+  TempDir dir("attribute");
+  const auto slow = testing::ballParticles({30, 48, 48}, 12), fast = testing::ballParticles({66, 48, 48}, 12);
+  std::vector<glm::vec3> particles = slow, velocities(slow.size(), glm::vec3(1, 0, 0));
+  particles.insert(particles.end(), fast.begin(), fast.end());
+  velocities.resize(particles.size(), glm::vec3(0, 0, 3));
+  BrickStore store = testing::makeStore(dir / "store", {particles}, 96.0f, 32, {velocities});
+  ASSERT_EQ(store.header().attribute, AttributeKind::Speed);
+  RenderSettings settings = testing::smallSettings();
+  auto renderer = cpuRenderer(store, settings);
+  Camera camera;
+  camera.target = {48, 48, 48};
+  camera.eye = {48, 48, 170};
+  const RenderResult result = renderer->render(0, camera);
+  int left = 0, right = 0;
+  for (std::uint32_t y = 0; y < settings.height; ++y) {
+    for (std::uint32_t x = 0; x < settings.width; ++x) {
+      const RayHit& hit = result.hits[y * settings.width + x];
+      if (hit.status != kRayHit) continue;
+      const bool isLeft = x < settings.width / 2;
+      (isLeft ? left : right)++;
+      EXPECT_EQ(hit.normal.w, isLeft ? 0.0f : 1.0f) << x << "," << y;
+    }
+  }
+  EXPECT_GT(left, 100);
+  EXPECT_GT(right, 100);
+}
+
+TEST(FrameRenderer, ColdFrameConvergesToTheWarmImageInOnePass) {
+  TempDir dir("warm");
+  BrickStore store = testing::makeStore(dir / "store", {testing::cloudParticles(8000, 7, 64.0f)}, 64.0f, 32);
+  auto renderer = cpuRenderer(store, testing::smallSettings());
+  const Camera camera = frameOnBox(renderer->frameBounds(0), 128.0 / 72.0);
+  const RenderResult cold = renderer->render(0, camera);
+  const RenderResult warm = renderer->render(0, camera);
+  EXPECT_GT(cold.stats.passes, 1);
+  EXPECT_GT(cold.stats.bricksUploaded, 0u);
+  EXPECT_EQ(warm.stats.passes, 1);
+  EXPECT_EQ(warm.stats.bricksUploaded, 0u);
+  ASSERT_EQ(cold.hits.size(), warm.hits.size());
+  EXPECT_EQ(0, std::memcmp(cold.hits.data(), warm.hits.data(), cold.hits.size() * sizeof(RayHit)))
+      << firstDifference(cold.hits, warm.hits);
+}
+
+TEST(FrameRenderer, TinyPoolConvergesByEvictionToTheSameImage) {
+  TempDir dir("tiny");
+  BrickStore store = testing::makeStore(dir / "store", {testing::cloudParticles(20000, 9, 96.0f)}, 96.0f, 32);
+  RenderSettings big = testing::smallSettings();
+  RenderSettings tiny = big;
+  tiny.gpuBudgetBytes = PoolLayout::forBudget(32, 1, false, 64ull << 20).slotBytes() * 3;
+  auto reference = cpuRenderer(store, big);
+  auto starved = cpuRenderer(store, tiny);
+  const Camera camera = frameOnBox(reference->frameBounds(0), 128.0 / 72.0);
+  const RenderResult expected = reference->render(0, camera);
+  const RenderResult result = starved->render(0, camera);
+  ASSERT_TRUE(result.stats.converged);
+  EXPECT_EQ(starved->settings().gpuBudgetBytes, tiny.gpuBudgetBytes);
+  EXPECT_GT(result.stats.bricksEvicted, 0u);
+  EXPECT_LE(result.stats.bricksResident, 3u);
+  EXPECT_GT(result.stats.passes, expected.stats.passes);
+  EXPECT_EQ(0, std::memcmp(expected.hits.data(), result.hits.data(), result.hits.size() * sizeof(RayHit)))
+      << firstDifference(expected.hits, result.hits);
+}
+
+TEST(FrameRenderer, RejectsMissingFramesAndBadSettings) {
+  TempDir dir("bad");
+  BrickStore store = testing::makeStore(dir / "store", {testing::ballParticles({20, 20, 20}, 5)}, 40.0f, 32);
+  auto renderer = cpuRenderer(store, testing::smallSettings());
+  EXPECT_THROW(renderer->render(5, frameOnBox(renderer->frameBounds(0), 1.0)), InputError);
+  RenderSettings settings = testing::smallSettings();
+  settings.radius = 9;
+  EXPECT_THROW(cpuRenderer(store, settings), InputError);
+  settings = testing::smallSettings();
+  settings.gpuBudgetBytes = 1000;
+  EXPECT_THROW(cpuRenderer(store, settings), InputError);
+}
+
+}  // namespace
+}  // namespace flipscope

@@ -1,0 +1,112 @@
+// flipscope render and demo end to end: PNG and EXR files, flipbook names, the camera options,
+// and clear errors with exit codes 2 (bad options) and 3 (bad files).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <glm/geometric.hpp>
+#include "TestSupport.h"
+
+#include "raycast/ImageWriter.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using flipscope::testing::CommandRun;
+CommandRun run(const std::string& args) { return flipscope::testing::runFlipscope(args); }
+
+class Render : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_EQ(run("synth -o " + path("f_####.bin") + " --particles 30k --frames 0-1").exitCode, 0);
+    CommandRun convert =
+        run("convert " + path("f_####.bin") + " -o " + path("store") + " --resolution 96 --brick-size 32 -q");
+    ASSERT_EQ(convert.exitCode, 0) << convert.output;
+  }
+  std::string path(const std::string& name) const { return (dir / name).string(); }
+  flipscope::testing::TempDir temp{"render"};
+  const fs::path& dir = temp.path();
+};
+
+TEST_F(Render, WritesPngAndExrWithDepthAndNormals) {
+  CommandRun png = run("render " + path("store") + " -o " + path("a.png") + " --size 64x36 --device cpu");
+  ASSERT_EQ(png.exitCode, 0) << png.output;
+  std::ifstream file(path("a.png"), std::ios::binary);
+  char magic[8] = {};
+  file.read(magic, 8);
+  EXPECT_EQ(std::string(magic + 1, 3), "PNG");
+
+  CommandRun exr = run("render " + path("store") + " -o " + path("a.exr") + " --size 64x36 --frame 1 --jitter off");
+  ASSERT_EQ(exr.exitCode, 0) << exr.output;
+  const flipscope::ExrContents contents = flipscope::readExr(path("a.exr"));
+  for (const char* channel : {"R", "G", "B", "A", "Z", "N.X", "N.Y", "N.Z"})
+    EXPECT_NE(std::find(contents.channels.begin(), contents.channels.end(), channel), contents.channels.end())
+        << channel;
+  std::size_t covered = 0;
+  for (std::size_t i = 0; i < contents.image.rgba.size(); ++i) {
+    if (contents.image.rgba[i].a == 0) continue;
+    ++covered;
+    EXPECT_GT(contents.image.depth[i], 0.0f);
+    EXPECT_NEAR(glm::length(contents.image.normal[i]), 1.0f, 1e-3f);
+  }
+  EXPECT_GT(covered, 64u * 36u / 10) << "the default camera frames the fluid";
+}
+
+TEST_F(Render, FlipbookAndCameraOptions) {
+  CommandRun seq = run("render " + path("store") + " -o " + path("seq_####.png") + " --frames 0-1 --size 32x18");
+  ASSERT_EQ(seq.exitCode, 0) << seq.output;
+  EXPECT_TRUE(fs::exists(path("seq_0000.png")));
+  EXPECT_TRUE(fs::exists(path("seq_0001.png")));
+
+  std::ofstream(path("cam.json")) << R"({"eye": [0.5, 0.4, 3.0], "target": [0.5, 0.2, 0.5], "fov": 35})";
+  CommandRun file =
+      run("render " + path("store") + " -o " + path("cam.png") + " --size 32x18 --camera-file " + path("cam.json"));
+  EXPECT_EQ(file.exitCode, 0) << file.output;
+  CommandRun inline_ = run("render " + path("store") + " -o " + path("cam2.png") +
+                           " --size 32x18 --camera 0.5,0.4,3,0.5,0.2,0.5,0,1,0,35");
+  EXPECT_EQ(inline_.exitCode, 0) << inline_.output;
+}
+
+TEST_F(Render, BadInputsGiveClearErrors) {
+  // Exit code 2: a bad option or value; 3: an unreadable or damaged file.
+  const auto expectError = [&](const std::string& args, const std::string& needle, int code = 2) {
+    CommandRun r = run("render " + args);
+    EXPECT_EQ(r.exitCode, code) << args << "\n" << r.output;
+    EXPECT_NE(r.output.find(needle), std::string::npos) << args << "\n" << r.output;
+  };
+  expectError(path("store") + " -o " + path("x.png") + " --frame 7", "no frame 7");
+  expectError(path("store") + " -o " + path("x.tif"), "must end in .exr or .png");
+  expectError(path("store") + " -o " + path("x.png") + " --frames 0-1", "'#'");
+  expectError(path("store") + " -o " + path("x.png") + " --camera 1,2,3", "expected 10 numbers");
+  expectError(path("store") + " -o " + path("x.png") + " --camera 0,0,0,0,0,0,0,1,0,40", "same point");
+  expectError(path("store") + " -o " + path("x.png") + " --camera-file " + path("missing.json"), "missing.json", 3);
+  expectError(path("store") + " -o " + path("x.png") + " --size 0x10", "--size");
+  expectError(path("store") + " -o " + path("x.png") + " --radius 12", "border");
+  expectError(path("nowhere") + " -o " + path("x.png"), "nowhere", 3);
+  EXPECT_FALSE(fs::exists(path("x.png")));
+
+  // Damaged brick payloads: the error names the frame file; no image is left behind.
+  const fs::path frame = dir / "store" / "frame_000000.fsf";
+  {
+    const auto size = std::streamoff(fs::file_size(frame));
+    std::fstream f(frame, std::ios::in | std::ios::out | std::ios::binary);
+    for (std::streamoff offset = 16; offset < size / 2; offset += 61) {
+      f.seekp(offset);
+      f.put('\x5a');
+    }
+  }
+  expectError(path("store") + " -o " + path("x.png") + " --size 32x18 --device cpu", "frame_000000.fsf", 3);
+  EXPECT_FALSE(fs::exists(path("x.png")));
+}
+
+TEST(Demo, RendersAPreviewImage) {
+  flipscope::testing::TempDir temp("demo");
+  CommandRun demo = run("demo -o " + (temp.path() / "out").string() + " --particles 50k --frames 2 --size 96x54");
+  ASSERT_EQ(demo.exitCode, 0) << demo.output;
+  EXPECT_TRUE(fs::exists(temp.path() / "out" / "preview.png"));
+  EXPECT_NE(demo.output.find("preview.png"), std::string::npos) << demo.output;
+}
+
+}  // namespace

@@ -1,0 +1,93 @@
+#include "tools/RenderJob.h"
+
+#include <cstdio>
+#include <filesystem>
+
+#include "core/Error.h"
+#include "raycast/ImageWriter.h"
+#include "raycast/Shading.h"
+
+namespace flipscope::tools {
+
+std::string outputPathForFrame(const std::string& pattern, int frame) {
+  std::string out;
+  for (std::size_t i = 0; i < pattern.size();) {
+    if (pattern[i] != '#') {
+      out += pattern[i++];
+      continue;
+    }
+    std::size_t run = 0;
+    while (i + run < pattern.size() && pattern[i + run] == '#') ++run;
+    std::string digits = std::to_string(std::abs(frame));
+    if (digits.size() < run) digits.insert(0, run - digits.size(), '0');
+    out += (frame < 0 ? "-" : "") + digits;
+    i += run;
+  }
+  return out;
+}
+
+namespace {
+std::string extensionOf(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+}  // namespace
+
+std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
+  BrickStore store = BrickStore::open(job.store);
+  const std::vector<int> stored = store.frames();
+  if (stored.empty()) throw InputError(job.store + ": the store has no frames");
+  const int first = job.firstFrame.value_or(stored.front());
+  const int last = job.lastFrame.value_or(first);
+  if (last < first) throw InputError("--frames: the last frame comes before the first");
+  for (int f = first; f <= last; ++f)
+    if (!store.hasFrame(f))
+      throw InputError(job.store + ": the store has no frame " + std::to_string(f) + " (it has " +
+                       std::to_string(stored.front()) + "-" + std::to_string(stored.back()) + ")");
+  const std::string ext = extensionOf(job.output);
+  if (ext != ".exr" && ext != ".png") throw InputError("-o: '" + job.output + "' must end in .exr or .png");
+  if (last > first && job.output.find('#') == std::string::npos)
+    throw InputError("-o: rendering frames " + std::to_string(first) + "-" + std::to_string(last) +
+                     " needs '#' in the output name (e.g. out_####.exr)");
+
+  std::string fallback;
+  auto device = createRaycastDevice(job.device, &fallback);
+  if (!job.quiet) {
+    if (!fallback.empty())
+      std::fprintf(stderr, "render: no GPU context (%s); using the CPU reference ray-caster\n", fallback.c_str());
+    std::printf("render: %s\n", device->name().c_str());
+  }
+  FrameRenderer renderer(store, std::move(device), job.settings);
+
+  Camera camera;
+  if (job.camera) {
+    camera = *job.camera;
+  } else {
+    Box bounds;  // all frames, so a flipbook keeps one camera
+    for (int f = first; f <= last; ++f) bounds.extend(renderer.frameBounds(f));
+    if (bounds.isEmpty()) bounds = Box{store.header().origin, store.header().domainMax()};
+    camera = frameOnBox(bounds, double(job.settings.width) / job.settings.height, job.up);
+  }
+
+  std::vector<RenderedFile> files;
+  for (int f = first; f <= last; ++f) {
+    const RenderResult result = renderer.render(f, camera, last > first ? 1 : 0);
+    const std::string path = outputPathForFrame(job.output, f);
+    writeImage(path, shade(result, camera));
+    const RenderStats& s = result.stats;
+    if (!job.quiet) {
+      std::printf(
+          "  frame %d: %ux%u, %d passes%s, %llu bricks uploaded (%zu in the frame), %.0f ms "
+          "(trace %.0f, stream %.0f, upload %.0f) -> %s\n",
+          f, result.width, result.height, s.passes, s.converged ? "" : " (pass limit: not converged)",
+          (unsigned long long)s.bricksUploaded, s.frameBricks, s.totalMs, s.traceMs, s.streamMs, s.uploadMs,
+          path.c_str());
+      std::fflush(stdout);
+    }
+    files.push_back({f, path, s});
+  }
+  return files;
+}
+
+}  // namespace flipscope::tools

@@ -1,0 +1,41 @@
+// A render job: frames of a brick store through FrameRenderer to EXR/PNG files, shared by
+// `flipscope render` and `flipscope demo`.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "raycast/Camera.h"
+#include "raycast/FrameRenderer.h"
+#include "raycast/GpuRaycaster.h"
+
+namespace flipscope::tools {
+
+struct RenderJob {
+  std::string store;
+  std::string output;             ///< .exr or .png; '#' runs take the zero-padded frame number
+  std::optional<int> firstFrame;  ///< default: the store's first frame
+  std::optional<int> lastFrame;   ///< inclusive; default: firstFrame
+  RenderSettings settings;
+  std::optional<Camera> camera;  ///< default: framed on the frames' bricks
+  glm::dvec3 up{0, 1, 0};        ///< up axis of the default camera
+  DeviceChoice device = DeviceChoice::Auto;
+  bool quiet = false;
+};
+
+struct RenderedFile {
+  int frame;
+  std::string path;
+  RenderStats stats;
+};
+
+/// Renders every frame of the job (frames missing from the store are an InputError naming the
+/// store and the frame, checked before anything is written). Prints the device and one line per
+/// frame unless quiet.
+std::vector<RenderedFile> runRenderJob(const RenderJob& job);
+
+/// `pattern` with each run of '#' replaced by `frame`, zero-padded to the run's length.
+std::string outputPathForFrame(const std::string& pattern, int frame);
+
+}  // namespace flipscope::tools
