@@ -53,10 +53,14 @@ std::string CpuRaycaster::name() const {
 
 void CpuRaycaster::allocatePool(const PoolLayout& layout) {
   mPool.layout = layout;
-  mPool.subBricks.assign(std::size_t(layout.slots) * layout.subBricksPerSlot, glm::uvec4(0));
-  mPool.mipWords.assign(std::size_t(layout.slots) * layout.mipWordsPerSlot, 0);
-  mPool.attributeBases.assign(layout.attributes ? std::size_t(layout.slots) * layout.subBricksPerSlot : 0, 0);
-  mPool.attributes.assign(layout.attributeCapacity, 0);
+  mPool.subBricks.clear();
+  mPool.subBricks.resize(std::size_t(layout.slots) * layout.subBricksPerSlot);
+  mPool.mipWords.clear();
+  mPool.mipWords.resize(std::size_t(layout.slots) * layout.mipWordsPerSlot);
+  mPool.attributeBases.clear();
+  mPool.attributeBases.resize(layout.attributes ? std::size_t(layout.slots) * layout.subBricksPerSlot : 0);
+  mPool.attributes.clear();
+  mPool.attributes.resize(layout.attributeCapacity);
 }
 
 void CpuRaycaster::setOctree(std::span<const OctreeNode> nodes) {

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <memory>
 
+#include "core/UninitializedVector.h"
 #include "raycast/RaycastDevice.h"
 
 namespace flipscope {
@@ -22,15 +23,17 @@ class CpuRaycaster : public RaycastDevice {
   double lastTraceMs() const override { return mLastTraceMs; }
   std::vector<RayHit> readHits() override { return mHits; }
 
-  /// The pool's arrays, laid out as the GPU's buffers (for tests).
+  /// The pool's arrays, laid out as the GPU's buffers. Slots are left uninitialized until a
+  /// brick is uploaded (the page table never points at an empty slot), so a large budget costs
+  /// no time to allocate.
   struct Pool {
     PoolLayout layout;
     std::vector<glm::uvec2> nodes;
     std::vector<std::uint32_t> pageTable;
-    std::vector<glm::uvec4> subBricks;
-    std::vector<std::uint32_t> mipWords;
-    std::vector<std::uint32_t> attributeBases;
-    std::vector<std::uint16_t> attributes;
+    UninitializedVector<glm::uvec4> subBricks;
+    UninitializedVector<std::uint32_t> mipWords;
+    UninitializedVector<std::uint32_t> attributeBases;
+    UninitializedVector<std::uint16_t> attributes;
   };
   const Pool& pool() const { return mPool; }
 

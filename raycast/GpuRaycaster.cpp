@@ -37,7 +37,8 @@ GpuRaycaster::GpuRaycaster()
   glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxBlock);
   mMaxBufferBytes = std::uint64_t(maxBlock);
   // llvmpipe answers timer queries with ~0: time its passes on the wall clock instead.
-  mWallClockTiming = mContext.renderer().find("llvmpipe") != std::string::npos;
+  const std::string renderer = mContext.renderer();
+  mSoftware = renderer.find("llvmpipe") != std::string::npos || renderer.find("softpipe") != std::string::npos;
   mParams = makeBuffer(sizeof(RaycastParams));
 }
 
@@ -125,7 +126,7 @@ std::vector<std::uint32_t> GpuRaycaster::trace(const RaycastParams& params) {
   if (count) mRequests.download(4, count * 4, requests.data());
   std::sort(requests.begin(), requests.end());
   requests.erase(std::unique(requests.begin(), requests.end()), requests.end());
-  mLastTraceMs = mWallClockTiming
+  mLastTraceMs = mSoftware
                      ? std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()
                      : mTimer.milliseconds();
   return requests;
@@ -141,7 +142,13 @@ std::vector<RayHit> GpuRaycaster::readHits() {
 std::unique_ptr<RaycastDevice> createRaycastDevice(DeviceChoice choice, std::string* fallbackReason) {
   if (choice == DeviceChoice::Cpu) return std::make_unique<CpuRaycaster>();
   try {
-    return std::make_unique<GpuRaycaster>();
+    auto gpu = std::make_unique<GpuRaycaster>();
+    if (choice == DeviceChoice::Auto && gpu->isSoftwareRenderer()) {
+      if (fallbackReason)
+        *fallbackReason = "the OpenGL renderer is software (" + gpu->name() + "), slower than the CPU reference";
+      return std::make_unique<CpuRaycaster>();
+    }
+    return gpu;
   } catch (const gl::Unavailable& e) {
     if (choice == DeviceChoice::Gpu) throw;
     if (fallbackReason) *fallbackReason = e.what();

@@ -19,6 +19,8 @@ class GpuRaycaster : public RaycastDevice {
   ~GpuRaycaster() override;
 
   std::string name() const override;
+  /// Mesa's llvmpipe or softpipe: OpenGL on the CPU.
+  bool isSoftwareRenderer() const { return mSoftware; }
   std::uint64_t maxBufferBytes() const override { return mMaxBufferBytes; }
   void allocatePool(const PoolLayout& layout) override;
   void setOctree(std::span<const OctreeNode> nodes) override;
@@ -39,14 +41,14 @@ class GpuRaycaster : public RaycastDevice {
   std::size_t mBricks = 0;  ///< bricks of the current frame (page table entries)
   gl::Buffer mParams, mNodes, mPages, mSubBricks, mMips, mAttributeBases, mAttributes, mHits, mRequests, mRequestFlags;
   double mLastTraceMs = 0;
-  bool mWallClockTiming = false;  ///< software rasterizer: timer queries are meaningless
+  bool mSoftware = false;  ///< Mesa llvmpipe/softpipe: timer queries return ~0, passes are timed on the wall clock
 };
 
 enum class DeviceChoice { Auto, Gpu, Cpu };
 
-/// The device a command asked for: Gpu (throws gl::Unavailable without one), Cpu (the reference
-/// ray-caster), or Auto (OpenGL when EGL gives a context, else the CPU reference; `fallbackReason`
-/// then says why).
+/// The device a command asked for: Gpu (OpenGL, llvmpipe included; throws gl::Unavailable
+/// without a context), Cpu (the reference ray-caster), or Auto (OpenGL on a hardware GPU, else
+/// the CPU reference, which beats llvmpipe by about 3x on two cores; `fallbackReason` says why).
 std::unique_ptr<RaycastDevice> createRaycastDevice(DeviceChoice choice, std::string* fallbackReason = nullptr);
 
 }  // namespace flipscope

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "core/Error.h"
+#include "core/Progress.h"
 #include "raycast/ImageWriter.h"
 #include "raycast/Shading.h"
 
@@ -54,8 +55,7 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
   std::string fallback;
   auto device = createRaycastDevice(job.device, &fallback);
   if (!job.quiet) {
-    if (!fallback.empty())
-      std::fprintf(stderr, "render: no GPU context (%s); using the CPU reference ray-caster\n", fallback.c_str());
+    if (!fallback.empty()) std::fprintf(stderr, "render: using the CPU reference ray-caster: %s\n", fallback.c_str());
     std::printf("render: %s\n", device->name().c_str());
   }
   FrameRenderer renderer(store, std::move(device), job.settings);
@@ -78,11 +78,12 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
     const RenderStats& s = result.stats;
     if (!job.quiet) {
       std::printf(
-          "  frame %d: %ux%u, %d passes%s, %llu bricks uploaded (%zu in the frame), %.0f ms "
-          "(trace %.0f, stream %.0f, upload %.0f) -> %s\n",
+          "  frame %d: %ux%u, %d passes%s; bricks: %llu requested, %llu uploaded, %zu resident (pool %sB), "
+          "%zu in the frame; %.0f ms (trace %.0f, stream %.0f, upload %.0f) -> %s\n",
           f, result.width, result.height, s.passes, s.converged ? "" : " (pass limit: not converged)",
-          (unsigned long long)s.bricksUploaded, s.frameBricks, s.totalMs, s.traceMs, s.streamMs, s.uploadMs,
-          path.c_str());
+          (unsigned long long)s.bricksRequested, (unsigned long long)s.bricksUploaded, s.bricksResident,
+          Progress::humanCount(double(s.poolBytes)).c_str(), s.frameBricks, s.totalMs, s.traceMs, s.streamMs,
+          s.uploadMs, path.c_str());
       std::fflush(stdout);
     }
     files.push_back({f, path, s});
