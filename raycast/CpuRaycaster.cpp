@@ -91,10 +91,7 @@ void CpuRaycaster::uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset
 void CpuRaycaster::beginImage(std::uint32_t width, std::uint32_t height) {
   mWidth = width;
   mHeight = height;
-  RayHit pending{};
-  pending.status = kRayPending;
-  pending.brickIndex = kNotResident;
-  mHits.assign(std::size_t(width) * height, pending);
+  mHits.assign(std::size_t(width) * height, pendingRay());
 }
 
 std::vector<std::uint32_t> CpuRaycaster::trace(const RaycastParams& params) {

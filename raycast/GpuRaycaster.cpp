@@ -86,10 +86,7 @@ void GpuRaycaster::uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset
 void GpuRaycaster::beginImage(std::uint32_t width, std::uint32_t height) {
   mWidth = width;
   mHeight = height;
-  RayHit pending{};
-  pending.status = kRayPending;
-  pending.brickIndex = kNotResident;
-  const std::vector<RayHit> rays(std::size_t(width) * height, pending);
+  const std::vector<RayHit> rays(std::size_t(width) * height, pendingRay());
   if (mHits.size() != rays.size() * sizeof(RayHit)) {
     mHits = makeBuffer(rays.size() * sizeof(RayHit), rays.data());
   } else {
@@ -126,9 +123,8 @@ std::vector<std::uint32_t> GpuRaycaster::trace(const RaycastParams& params) {
   if (count) mRequests.download(4, count * 4, requests.data());
   std::sort(requests.begin(), requests.end());
   requests.erase(std::unique(requests.begin(), requests.end()), requests.end());
-  mLastTraceMs = mSoftware
-                     ? std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()
-                     : mTimer.milliseconds();
+  mLastTraceMs = mSoftware ? std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()
+                           : mTimer.milliseconds();
   return requests;
 }
 

@@ -54,8 +54,10 @@ std::vector<std::filesystem::path> mantaflowFiles() {
 
 TEST(MantaflowVdb, CountsMatchOpenVdbAndPositionsLieInTheGrid) {
   auto files = mantaflowFiles();
-  if (files.empty()) GTEST_SKIP() << "no Mantaflow sample under " << FLIPSCOPE_DATA_DIR;
-  EXPECT_EQ(files.size(), 60u);
+  // 30 frames of FLIP and secondary particles in ../shared/data; frames 1, 2 and 30 in the
+  // repository's tests/data when the shared folder is not beside the checkout.
+  ASSERT_GE(files.size(), 6u) << "Mantaflow sample under " << FLIPSCOPE_DATA_DIR;
+  EXPECT_EQ(files.size() % 2, 0u);
   std::uint64_t total = 0;
   for (const auto& path : files) {
     OpenVdbPoints oracle = openVdbOracle(path);
@@ -82,7 +84,7 @@ TEST(MantaflowVdb, CountsMatchOpenVdbAndPositionsLieInTheGrid) {
 
 TEST(MantaflowVdb, GridsSelectedByName) {
   auto path = std::filesystem::path(FLIPSCOPE_DATA_DIR) / "mantaflow-dam64/data/fluid_data_0030.vdb";
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+  ASSERT_TRUE(std::filesystem::exists(path)) << "no " << path;
   ReadOptions options;
   options.grids = {"particles"};
   EXPECT_EQ(openParticleFile(path, options)->countHint(), openVdbOracle(path).count);
