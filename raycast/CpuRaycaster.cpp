@@ -91,7 +91,7 @@ void CpuRaycaster::uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset
 void CpuRaycaster::beginImage(std::uint32_t width, std::uint32_t height) {
   mWidth = width;
   mHeight = height;
-  mHits.assign(std::size_t(width) * height, pendingRay());
+  mHits.assign(std::size_t(width) * height, RayHit{});  // zeros: fresh pending rays
 }
 
 std::vector<std::uint32_t> CpuRaycaster::trace(const RaycastParams& params) {

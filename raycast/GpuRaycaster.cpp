@@ -86,12 +86,9 @@ void GpuRaycaster::uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset
 void GpuRaycaster::beginImage(std::uint32_t width, std::uint32_t height) {
   mWidth = width;
   mHeight = height;
-  const std::vector<RayHit> rays(std::size_t(width) * height, pendingRay());
-  if (mHits.size() != rays.size() * sizeof(RayHit)) {
-    mHits = makeBuffer(rays.size() * sizeof(RayHit), rays.data());
-  } else {
-    mHits.upload(0, rays.data(), rays.size() * sizeof(RayHit));
-  }
+  const std::uint64_t bytes = std::uint64_t(width) * height * sizeof(RayHit);
+  if (mHits.size() != bytes) mHits = makeBuffer(bytes);
+  mHits.clearZero();  // zeros: fresh pending rays, cleared on the device (no upload)
 }
 
 std::vector<std::uint32_t> GpuRaycaster::trace(const RaycastParams& params) {

@@ -31,7 +31,7 @@ class RaycastDevice {
   virtual void setPageTable(std::span<const std::uint32_t> pageTable) = 0;
   /// Writes a converted brick into `slot`; its attributes go to ring entries from `attributeOffset`.
   virtual void uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset, const ConvertedBrick& brick) = 0;
-  /// Starts an image: every ray pending at t = 0.
+  /// Starts an image: every ray fresh (a zeroed RayHit: pending at t = 0).
   virtual void beginImage(std::uint32_t width, std::uint32_t height) = 0;
   /// One pass over the pending rays. Returns the brick indices that rays stopped at, ascending
   /// and unique.

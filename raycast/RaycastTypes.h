@@ -22,14 +22,8 @@ using glsl::RayHit;
 static_assert(sizeof(RaycastParams) == 9 * 16);
 static_assert(offsetof(RaycastParams, image) == 64 && offsetof(RaycastParams, sphere) == 128);
 static_assert(sizeof(RayHit) == 32);
+static_assert(kRayPending == 0, "a zeroed RayHit is a fresh pending ray");
 static_assert(offsetof(RayHit, t) == 16 && offsetof(RayHit, status) == 20 && offsetof(RayHit, depth) == 24 &&
               offsetof(RayHit, brickIndex) == 28);
 
-/// A ray at the start of an image: pending from t = 0, waiting for no brick.
-inline RayHit pendingRay() {
-  RayHit ray{};
-  ray.status = kRayPending;
-  ray.brickIndex = kNotResident;
-  return ray;
-}
 }  // namespace flipscope

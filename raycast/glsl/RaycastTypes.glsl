@@ -19,8 +19,9 @@ struct RaycastParams {
   vec4 sphere;   // x: radius in cells; y: max jitter in cells; z, w: unused
 };
 
-// One pixel's ray. While pending, t is where the ray resumes (it stopped at a brick that was not
-// resident); once hit, t is the hit distance in cells.
+// One pixel's ray. All zeros is a fresh ray: pending from t = 0 (so a device clears the whole
+// image with zeros). While pending, t is where the ray resumes (it stopped at a brick that was
+// not resident); once hit, t is the hit distance in cells.
 const uint kRayPending = 0u;
 const uint kRayHit = 1u;
 const uint kRayMiss = 2u;
@@ -30,7 +31,8 @@ struct RayHit {
   float t;         // cells along the unit ray direction
   uint status;     // kRayPending, kRayHit or kRayMiss
   float depth;     // linear camera depth in world units (t * cellSize * dot(dir, forward))
-  uint brickIndex; // brick of the hit, or the brick the pending ray waits for
+  uint brickIndex; // brick of the hit, or the brick a pending ray waits for (0 before the first
+                   // pass), kNotResident on a miss
 };
 
 const uint kNotResident = 0xffffffffu;
