@@ -131,6 +131,10 @@ RaycastParams FrameRenderer::params(const Camera& camera, const FrameIndex& fram
   p.pool = glm::uvec4(layout.mipWordsPerSlot, layout.attributes ? 1u : 0u, std::uint32_t(frame.bricks.size()),
                       layout.mipLevels);
   p.sphere = glm::vec4(mSettings.radius, mSettings.jitter, 0.0f, 0.0f);
+  FLIPSCOPE_CHECK(layout.mipLevels <= kMaxMipLevels, "mip levels " << layout.mipLevels);
+  for (std::uint32_t level = 1; level <= layout.mipLevels; ++level)
+    p.mipLevels[level - 1] =
+        glm::uvec4(bitBrickMipDims(level, h.brickSize, mReach), bitBrickMipWordOffset(level, h.brickSize, mReach));
   return p;
 }
 

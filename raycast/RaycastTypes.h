@@ -11,6 +11,7 @@ namespace flipscope::glsl {
 }  // namespace flipscope::glsl
 
 namespace flipscope {
+using glsl::kMaxMipLevels;
 using glsl::kNotResident;
 using glsl::kRayHit;
 using glsl::kRayMiss;
@@ -19,8 +20,9 @@ using glsl::RaycastParams;
 using glsl::RayHit;
 
 // std140 and std430 agree with C++ for these members (16-byte vectors, then 4-byte scalars).
-static_assert(sizeof(RaycastParams) == 9 * 16);
-static_assert(offsetof(RaycastParams, image) == 64 && offsetof(RaycastParams, sphere) == 128);
+static_assert(sizeof(RaycastParams) == 17 * 16);
+static_assert(offsetof(RaycastParams, image) == 64 && offsetof(RaycastParams, sphere) == 128 &&
+              offsetof(RaycastParams, mipLevels) == 144);
 static_assert(sizeof(RayHit) == 32);
 static_assert(kRayPending == 0, "a zeroed RayHit is a fresh pending ray");
 static_assert(offsetof(RayHit, t) == 16 && offsetof(RayHit, status) == 20 && offsetof(RayHit, depth) == 24 &&

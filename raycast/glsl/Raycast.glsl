@@ -20,10 +20,11 @@
 //  1. the brick containing the ray's point is found by descending the octree; an empty octant is
 //     skipped to its exit;
 //  2. a brick that is not resident is requested and the ray stops (kRayPending, resumes at t);
-//  3. inside a brick, the coarsest clear mip block around the point is skipped to its exit;
-//     otherwise the spheres of the (2k+1)^3 cells around the point's cell are tested, and the
-//     nearest hit no farther than the cell's exit ends the ray (a nearer hit would have been
-//     found in an earlier cell).
+//  3. inside a brick, the coarsest clear mip block around the point is skipped to its exit
+//     (levels and their word offsets come precomputed in P.mipLevels);
+//     otherwise the spheres of the (2k+1)^3 cells around the point's cell are tested (those
+//     not tested at the previous cell), and once the nearest hit so far lies no farther than
+//     the cell's exit it ends the ray (a nearer hit would have been found in an earlier cell).
 
 // A small step past a box exit, so that point location lands in the next box.
 FS_FUNC float rcStepPast(float t) { return t + 1.0e-3f + abs(t) * 4.0e-7f; }
@@ -73,12 +74,11 @@ FS_FUNC float rcCellAttribute(uint slot, ivec3 cell) {
 
 // Whether the mip block of `level` around brick-local `cell` is clear (holds no sphere).
 FS_FUNC bool rcMipClear(uint slot, uint level, ivec3 cell) {
-  uint overlap = P.brick.x;
-  uint brickSize = P.grid.w;
-  uvec3 s = uvec3(cell + ivec3(int(overlap)));
+  uvec3 s = uvec3(cell + ivec3(int(P.brick.x)));
   uvec3 block = uvec3(s.x >> (level + 1u), s.y >> (level + 1u), s.z >> (level + 2u));
-  uint bit = bitBrickMipBitIndex(block, level, brickSize, overlap);
-  uint word = rcMipWord(slot, bitBrickMipWordOffset(level, brickSize, overlap) + (bit >> 5u));
+  uvec4 dims = P.mipLevels[level - 1u];
+  uint bit = block.x + dims.x * (block.y + dims.y * block.z);
+  uint word = rcMipWord(slot, dims.w + (bit >> 5u));
   return ((word >> (bit & 31u)) & 1u) == 0u;
 }
 
@@ -93,31 +93,39 @@ FS_FUNC RayHit rcTraceBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec
   vec3 brickOrigin = vec3(brick * uvec3(uint(B)));
   vec3 o = eye - brickOrigin;  // ray origin in brick-local cells
   vec3 invDir = rcSafeInverse(dir);
+  // The nearest sphere hit found so far, from any cell tested in this brick. Spheres of cells
+  // within k of the previously tested cell were tested already: a step tests only the cells
+  // that enter the neighbourhood (9 of 27 for k = 1 on a face step).
+  float best = 3.0e38f;
+  ivec3 bestCell = ivec3(0);
+  vec3 bestNormal = vec3(0.0f);
+  ivec3 previous = ivec3(-1000000);
   for (uint step = 0u; step < kRaycastMaxSteps; step++) {
     if (t > tEnd) return result;
     vec3 p = o + t * dir;
     ivec3 cell = clamp(ivec3(floor(p)), ivec3(0), ivec3(B - 1));
-    // Empty-space skipping (§4.2): the coarsest clear block around the cell.
-    bool skipped = false;
-    for (uint level = levels; level >= 1u && !skipped; level--) {
-      if (rcMipClear(slot, level, cell)) {
-        int overlap = int(P.brick.x);
-        ivec3 size = ivec3(2 << level, 2 << level, 4 << level);
-        ivec3 s = cell + ivec3(overlap);
-        ivec3 lo = ivec3((s.x / size.x) * size.x, (s.y / size.y) * size.y, (s.z / size.z) * size.z) - ivec3(overlap);
-        t = rcStepPast(rcBoxSpan(o, invDir, vec3(lo), vec3(lo + size)).y);
-        skipped = true;
-      }
+    // Empty-space skipping (§4.2): the coarsest clear block around the cell. A block's parent
+    // covers it, so once a level is set every coarser one is too: walk up from level 1.
+    uint clearLevel = 0u;
+    for (uint level = 1u; level <= levels; level++) {
+      if (!rcMipClear(slot, level, cell)) break;
+      clearLevel = level;
     }
-    if (skipped) continue;
+    if (clearLevel > 0u) {
+      int overlap = int(P.brick.x);
+      ivec3 size = ivec3(2 << clearLevel, 2 << clearLevel, 4 << clearLevel);
+      ivec3 s = cell + ivec3(overlap);
+      ivec3 lo = ivec3((s.x / size.x) * size.x, (s.y / size.y) * size.y, (s.z / size.z) * size.z) - ivec3(overlap);
+      t = rcStepPast(rcBoxSpan(o, invDir, vec3(lo), vec3(lo + size)).y);
+      continue;
+    }
     // §3.3.1: ray-sphere tests against the jittered centres of the cells around this one.
-    float best = 3.0e38f;
-    ivec3 bestCell = ivec3(0);
-    vec3 bestCentre = vec3(0.0f);
     for (int dz = -k; dz <= k; dz++) {
       for (int dy = -k; dy <= k; dy++) {
         for (int dx = -k; dx <= k; dx++) {
           ivec3 q = cell + ivec3(dx, dy, dz);
+          ivec3 seen = abs(q - previous);
+          if (max(max(seen.x, seen.y), seen.z) <= k) continue;
           if (!rcCellSet(slot, q)) continue;
           vec3 centre = vec3(q) + vec3(0.5f);
           if (jitter > 0.0f) {
@@ -131,19 +139,20 @@ FS_FUNC RayHit rcTraceBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec
           float c = dot(oc, oc) - radius * radius;
           float disc = b * b - c;
           if (disc < 0.0f) continue;
-          float tHit = t + (-b - sqrt(disc));
+          float local = -b - sqrt(disc);
+          float tHit = t + local;
           if (tHit >= 0.0f && tHit < best) {
             best = tHit;
             bestCell = q;
-            bestCentre = centre;
+            bestNormal = (oc + local * dir) / radius;
           }
         }
       }
     }
+    previous = cell;
     float cellExit = rcBoxSpan(o, invDir, vec3(cell), vec3(cell + ivec3(1))).y;
     if (best <= cellExit) {
-      vec3 n = (o + best * dir - bestCentre) / radius;
-      result.normal = vec4(normalize(n), rcCellAttribute(slot, bestCell));
+      result.normal = vec4(normalize(bestNormal), rcCellAttribute(slot, bestCell));
       result.t = best;
       result.status = kRayHit;
       return result;

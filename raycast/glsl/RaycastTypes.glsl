@@ -17,6 +17,7 @@ struct RaycastParams {
   uvec4 brick;   // x: overlap n; y: neighbourhood k; z: octree levels; w: sub-bricks per slot
   uvec4 pool;    // x: mip words per slot; y: 1 with attributes; z: bricks in the frame; w: mip levels
   vec4 sphere;   // x: radius in cells; y: max jitter in cells; z, w: unused
+  uvec4 mipLevels[8];  // level k (1..pool.w) at k - 1: xyz blocks per axis, w word offset
 };
 
 // One pixel's ray. All zeros is a fresh ray: pending from t = 0 (so a device clears the whole
@@ -36,4 +37,5 @@ struct RayHit {
 };
 
 const uint kNotResident = 0xffffffffu;
+const uint kMaxMipLevels = 8u;  // 144 stored cells (128 + 2 x 8) make 7
 const uint kRaycastMaxSteps = 65536u;  // bound on each traversal loop of one ray in one pass
