@@ -78,12 +78,12 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
     const RenderStats& s = result.stats;
     if (!job.quiet) {
       std::printf(
-          "  frame %d: %ux%u, %d passes%s; bricks: %llu requested, %llu uploaded, %zu resident (pool %sB), "
+          "  frame %d: %ux%u, %d %s%s; bricks: %llu requested, %llu uploaded, %zu resident (pool %sB), "
           "%zu in the frame; %.0f ms (trace %.0f, stream %.0f, upload %.0f) -> %s\n",
-          f, result.width, result.height, s.passes, s.converged ? "" : " (pass limit: not converged)",
-          (unsigned long long)s.bricksRequested, (unsigned long long)s.bricksUploaded, s.bricksResident,
-          Progress::humanCount(double(s.poolBytes)).c_str(), s.frameBricks, s.totalMs, s.traceMs, s.streamMs,
-          s.uploadMs, path.c_str());
+          f, result.width, result.height, s.passes, s.passes == 1 ? "pass" : "passes",
+          s.converged ? "" : " (pass limit: not converged)", (unsigned long long)s.bricksRequested,
+          (unsigned long long)s.bricksUploaded, s.bricksResident, Progress::humanCount(double(s.poolBytes)).c_str(),
+          s.frameBricks, s.totalMs, s.traceMs, s.streamMs, s.uploadMs, path.c_str());
       std::fflush(stdout);
     }
     files.push_back({f, path, s});
