@@ -70,8 +70,9 @@ double peakRssBytes() {
 }
 
 void runBenchPreprocess(const BenchPreprocessArgs& a) {
-  const fs::path work = a.workDir.empty() ? fs::temp_directory_path() / ("flipscope-bench-" + std::to_string(::getpid()))
-                                          : fs::path(a.workDir);
+  const fs::path work = a.workDir.empty()
+                            ? fs::temp_directory_path() / ("flipscope-bench-" + std::to_string(::getpid()))
+                            : fs::path(a.workDir);
   fs::create_directories(work);
   struct Cleanup {
     fs::path dir;
@@ -146,7 +147,8 @@ void runBenchPreprocess(const BenchPreprocessArgs& a) {
     return;
   }
   std::printf("bench preprocess: %s\n", source.c_str());
-  std::printf("input %s, %u threads\n\n", Progress::humanCount(double(rawBytes)).c_str() , unsigned(std::thread::hardware_concurrency()));
+  std::printf("input %s, %u threads\n\n", Progress::humanCount(double(rawBytes)).c_str(),
+              unsigned(std::thread::hardware_concurrency()));
   std::printf("%-34s %10s %16s %12s\n", "stage", "seconds", "particles/s", "x raw read");
   std::printf("%-34s %10.3f %16s %12s\n", "raw read (page cache, read())", readSeconds,
               Progress::humanCount(readRate).c_str(), "1.00");

@@ -54,13 +54,7 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> parseSizes(const std::strin
   std::vector<std::pair<std::uint32_t, std::uint32_t>> sizes;
   std::stringstream stream(text);
   std::string item;
-  while (std::getline(stream, item, ',')) {
-    unsigned w = 0, h = 0;
-    char x = 0;
-    if (std::sscanf(item.c_str(), "%u%c%u", &w, &x, &h) != 3 || x != 'x' || !w || !h)
-      throw InputError("--sizes: expected WxH[,WxH...], got '" + item + "'");
-    sizes.emplace_back(w, h);
-  }
+  while (std::getline(stream, item, ',')) sizes.push_back(parseImageSize("--sizes", item));
   return sizes;
 }
 
@@ -116,9 +110,7 @@ void runBenchRender(const BenchRenderArgs& a) {
     convertFrame(fluid, store, 0, options);
   }
 
-  const DeviceChoice choice = a.device == "gpu"   ? DeviceChoice::Gpu
-                              : a.device == "cpu" ? DeviceChoice::Cpu
-                                                  : DeviceChoice::Auto;
+  const DeviceChoice choice = parseDeviceChoice("--device", a.device);
   std::string deviceName;
   std::vector<SizeResult> results;
   Camera lastCamera;

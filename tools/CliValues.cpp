@@ -1,6 +1,7 @@
 #include "tools/CliValues.h"
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <vector>
 
@@ -33,10 +34,14 @@ std::uint64_t parseCount(const std::string& option, const std::string& text) {
   const char* expected = "a count such as 1000, 10k, 2.5M or 1G";
   auto [value, suffix] = numberAndSuffix(option, text, expected);
   double scale = 1;
-  if (suffix == "k" || suffix == "K") scale = 1e3;
-  else if (suffix == "M" || suffix == "m") scale = 1e6;
-  else if (suffix == "G" || suffix == "g") scale = 1e9;
-  else if (!suffix.empty()) bad(option, text, expected);
+  if (suffix == "k" || suffix == "K")
+    scale = 1e3;
+  else if (suffix == "M" || suffix == "m")
+    scale = 1e6;
+  else if (suffix == "G" || suffix == "g")
+    scale = 1e9;
+  else if (!suffix.empty())
+    bad(option, text, expected);
   const double count = std::round(value * scale);
   if (count > 1e15) bad(option, text, expected);
   return std::uint64_t(count);
@@ -46,10 +51,14 @@ std::uint64_t parseBytes(const std::string& option, const std::string& text) {
   const char* expected = "a size such as 512M, 4G or 64MiB";
   auto [value, suffix] = numberAndSuffix(option, text, expected);
   double scale = 1;
-  if (suffix == "k" || suffix == "K" || suffix == "KiB" || suffix == "kB") scale = 1024.0;
-  else if (suffix == "M" || suffix == "MiB" || suffix == "MB") scale = 1024.0 * 1024;
-  else if (suffix == "G" || suffix == "GiB" || suffix == "GB") scale = 1024.0 * 1024 * 1024;
-  else if (!suffix.empty() && suffix != "B") bad(option, text, expected);
+  if (suffix == "k" || suffix == "K" || suffix == "KiB" || suffix == "kB")
+    scale = 1024.0;
+  else if (suffix == "M" || suffix == "MiB" || suffix == "MB")
+    scale = 1024.0 * 1024;
+  else if (suffix == "G" || suffix == "GiB" || suffix == "GB")
+    scale = 1024.0 * 1024 * 1024;
+  else if (!suffix.empty() && suffix != "B")
+    bad(option, text, expected);
   const double bytes = std::round(value * scale);
   if (bytes < 1 || bytes > 1e18) bad(option, text, expected);
   return std::uint64_t(bytes);
@@ -73,6 +82,22 @@ Box parseBox(const std::string& option, const std::string& text) {
   Box box{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
   if (box.isEmpty()) bad(option, text, "min <= max on every axis");
   return box;
+}
+
+std::pair<std::uint32_t, std::uint32_t> parseImageSize(const std::string& option, const std::string& text) {
+  unsigned width = 0, height = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%u%c%u%c", &width, &x, &height, &extra) != 3 || (x != 'x' && x != 'X') || width == 0 ||
+      height == 0)
+    bad(option, text, "WxH, e.g. 1920x1080");
+  return {width, height};
+}
+
+DeviceChoice parseDeviceChoice(const std::string& option, const std::string& text) {
+  if (text == "auto") return DeviceChoice::Auto;
+  if (text == "gpu") return DeviceChoice::Gpu;
+  if (text == "cpu") return DeviceChoice::Cpu;
+  bad(option, text, "auto, gpu or cpu");
 }
 
 }  // namespace flipscope::tools

@@ -4,8 +4,10 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 
 #include "core/Box.h"
+#include "raycast/GpuRaycaster.h"
 
 namespace flipscope::tools {
 
@@ -15,5 +17,9 @@ std::uint64_t parseCount(const std::string& option, const std::string& text);
 std::uint64_t parseBytes(const std::string& option, const std::string& text);
 /// "x0,y0,z0,x1,y1,z1" -> box with min <= max.
 Box parseBox(const std::string& option, const std::string& text);
+/// "1920x1080" -> {1920, 1080}; both at least 1.
+std::pair<std::uint32_t, std::uint32_t> parseImageSize(const std::string& option, const std::string& text);
+/// "auto", "gpu" or "cpu" (the `--device` of render, demo and bench render).
+DeviceChoice parseDeviceChoice(const std::string& option, const std::string& text);
 
 }  // namespace flipscope::tools

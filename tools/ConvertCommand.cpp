@@ -36,8 +36,10 @@ void runConvert(const ConvertArgs& a) {
   options.brickSize = a.brickSize;
   if (!a.domain.empty()) options.domain = parseBox("--domain", a.domain);
   options.memoryBudget = parseBytes("--mem", a.mem);
-  if (a.attribute == "speed") options.attribute = true;
-  else if (a.attribute == "none") options.attribute = false;
+  if (a.attribute == "speed")
+    options.attribute = true;
+  else if (a.attribute == "none")
+    options.attribute = false;
   options.zstdLevel = a.zstdLevel;
   options.scratchDir = a.scratch;
   options.read.grids = a.grids;
@@ -68,7 +70,8 @@ void runConvert(const ConvertArgs& a) {
 
 void addConvertCommand(CLI::App& app) {
   auto args = std::make_shared<ConvertArgs>();
-  auto* cmd = app.add_subcommand("convert", "Bin particle caches (.vdb, .ply, .bin/.raw, sequences) into a brick store");
+  auto* cmd =
+      app.add_subcommand("convert", "Bin particle caches (.vdb, .ply, .bin/.raw, sequences) into a brick store");
   cmd->add_option("inputs", args->inputs,
                   "Input files or patterns (name_####.vdb, %04d, {}); several per frame merge into one frame")
       ->required();

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <tuple>
 
 #include "core/Error.h"
 #include "preprocess/Convert.h"
@@ -61,13 +62,9 @@ void runDemo(const DemoArgs& a) {
   job.store = storeDir.string();
   job.output = (out / "preview.png").string();
   job.firstFrame = job.lastFrame = a.frames - 1;
-  unsigned width = 0, height = 0;
-  if (std::sscanf(a.size.c_str(), "%ux%u", &width, &height) != 2)
-    throw InputError("--size: expected WxH, got '" + a.size + "'");
-  job.settings.width = width;
-  job.settings.height = height;
+  std::tie(job.settings.width, job.settings.height) = parseImageSize("--size", a.size);
   validate(job.settings);
-  job.device = a.device == "gpu" ? DeviceChoice::Gpu : a.device == "cpu" ? DeviceChoice::Cpu : DeviceChoice::Auto;
+  job.device = parseDeviceChoice("--device", a.device);
   runRenderJob(job);
   std::printf("demo: wrote preview image %s (render more with: flipscope render %s -o out_####.exr --frames 0-%d)\n",
               job.output.c_str(), storeDir.c_str(), a.frames - 1);

@@ -73,8 +73,11 @@ void runInfo(const InfoArgs& a) {
                              {"skipped_invalid", s.skippedInvalid},
                              {"skipped_outside", s.skippedOutside}});
     }
-    j["total"] = {{"particles", total.particles}, {"bricks", total.bricks},     {"bits_per_particle", bpp},
-                  {"store_bytes", total.storeBytes}, {"ratio_to_raw", ratio}};
+    j["total"] = {{"particles", total.particles},
+                  {"bricks", total.bricks},
+                  {"bits_per_particle", bpp},
+                  {"store_bytes", total.storeBytes},
+                  {"ratio_to_raw", ratio}};
     if (a.verify) {
       j["verified"] = damage.empty();
       j["damage"] = damage;
@@ -82,8 +85,8 @@ void runInfo(const InfoArgs& a) {
     std::printf("%s\n", j.dump(2).c_str());
   } else {
     std::printf("store      %s (version %u)\n", a.store.c_str(), h.version);
-    std::printf("domain     origin (%g, %g, %g), cell size %g, %ux%ux%u bricks of %u^3 cells\n", h.origin.x,
-                h.origin.y, h.origin.z, h.cellSize, h.brickGrid.x, h.brickGrid.y, h.brickGrid.z, h.brickSize);
+    std::printf("domain     origin (%g, %g, %g), cell size %g, %ux%ux%u bricks of %u^3 cells\n", h.origin.x, h.origin.y,
+                h.origin.z, h.cellSize, h.brickGrid.x, h.brickGrid.y, h.brickGrid.z, h.brickSize);
     std::printf("attribute  %s\n\n", attributeName(h.attribute));
     std::printf("%7s %14s %9s %8s %10s %12s %9s\n", "frame", "particles", "bricks", "fill", "bits/part", "bytes",
                 "raw/store");

@@ -2,6 +2,7 @@
 #include <CLI/CLI.hpp>
 
 #include <memory>
+#include <tuple>
 
 #include "core/Error.h"
 #include "preprocess/InputSequence.h"
@@ -29,15 +30,6 @@ struct RenderArgs {
   int maxPasses = 1000;
   bool quiet = false;
 };
-
-void parseSize(const std::string& text, RenderSettings& settings) {
-  unsigned w = 0, h = 0;
-  char x = 0, extra = 0;
-  if (std::sscanf(text.c_str(), "%u%c%u%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X'))
-    throw InputError("--size: expected WxH (e.g. 1920x1080), got '" + text + "'");
-  settings.width = w;
-  settings.height = h;
-}
 
 float parseJitter(const std::string& text) {
   if (text == "on") return 0.25f;
@@ -68,7 +60,7 @@ void runRender(const RenderArgs& a) {
     job.firstFrame = range.first;
     job.lastFrame = range.last;
   }
-  parseSize(a.size, job.settings);
+  std::tie(job.settings.width, job.settings.height) = parseImageSize("--size", a.size);
   job.settings.radius = a.radius;
   job.settings.jitter = parseJitter(a.jitter);
   job.settings.gpuBudgetBytes = parseBytes("--gpu-mem", a.gpuMem);
@@ -78,7 +70,7 @@ void runRender(const RenderArgs& a) {
   if (!a.camera.empty()) job.camera = parseCamera("--camera", a.camera);
   if (!a.cameraFile.empty()) job.camera = loadCamera(a.cameraFile);
   job.up = parseUp(a.up);
-  job.device = a.device == "gpu" ? DeviceChoice::Gpu : a.device == "cpu" ? DeviceChoice::Cpu : DeviceChoice::Auto;
+  job.device = parseDeviceChoice("--device", a.device);
   job.quiet = a.quiet;
   runRenderJob(job);
 }
