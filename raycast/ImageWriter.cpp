@@ -178,6 +178,11 @@ void writePng(const std::filesystem::path& path, const RenderImage& image) {
   reportingErrors(path, [&] { writeFileAtomically(path, encoded); });
 }
 
+bool isImagePath(const std::filesystem::path& path) {
+  const std::string extension = lowerExtension(path);
+  return extension == ".exr" || extension == ".png";
+}
+
 void writeImage(const std::filesystem::path& path, const RenderImage& image) {
   const std::string extension = lowerExtension(path);
   if (extension == ".exr")

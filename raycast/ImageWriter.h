@@ -37,6 +37,9 @@ void writeExr(const std::filesystem::path& path, const RenderImage& image);
 /// Throws FileError naming `path`.
 void writePng(const std::filesystem::path& path, const RenderImage& image);
 
+/// Whether writeImage takes `path`: it ends in .exr or .png, in any case.
+bool isImagePath(const std::filesystem::path& path);
+
 /// writeExr or writePng by the extension (.exr or .png, any case). Throws InputError naming
 /// `path` for any other extension.
 void writeImage(const std::filesystem::path& path, const RenderImage& image);

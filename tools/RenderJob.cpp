@@ -1,7 +1,6 @@
 #include "tools/RenderJob.h"
 
 #include <cstdio>
-#include <filesystem>
 
 #include "core/Error.h"
 #include "core/Progress.h"
@@ -27,14 +26,6 @@ std::string outputPathForFrame(const std::string& pattern, int frame) {
   return out;
 }
 
-namespace {
-std::string extensionOf(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
-}  // namespace
-
 std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
   BrickStore store = BrickStore::open(job.store);
   const std::vector<int> stored = store.frames();
@@ -46,8 +37,7 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
     if (!store.hasFrame(f))
       throw InputError(job.store + ": the store has no frame " + std::to_string(f) + " (it has " +
                        std::to_string(stored.front()) + "-" + std::to_string(stored.back()) + ")");
-  const std::string ext = extensionOf(job.output);
-  if (ext != ".exr" && ext != ".png") throw InputError("-o: '" + job.output + "' must end in .exr or .png");
+  if (!isImagePath(job.output)) throw InputError("-o: '" + job.output + "' must end in .exr or .png");
   if (last > first && job.output.find('#') == std::string::npos)
     throw InputError("-o: rendering frames " + std::to_string(first) + "-" + std::to_string(last) +
                      " needs '#' in the output name (e.g. out_####.exr)");

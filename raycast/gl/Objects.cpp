@@ -34,23 +34,19 @@ std::string numberedSource(std::string_view source) {
   return out;
 }
 
-std::string shaderLog(GLuint shader) {
+/// The info log of a shader or program, through its glGet*iv and glGet*InfoLog pair.
+template <class GetIv, class GetLog>
+std::string infoLog(GLuint object, GetIv getIv, GetLog getLog) {
   GLint length = 0;
-  glGetShaderiv(shader, GL_INFO_LOG_LENGTH, &length);
+  getIv(object, GL_INFO_LOG_LENGTH, &length);
   std::string log(std::size_t(std::max(length, 1)), '\0');
-  glGetShaderInfoLog(shader, GLsizei(log.size()), nullptr, log.data());
+  getLog(object, GLsizei(log.size()), nullptr, log.data());
   log.resize(log.find('\0') == std::string::npos ? log.size() : log.find('\0'));
   return log;
 }
 
-std::string programLog(GLuint program) {
-  GLint length = 0;
-  glGetProgramiv(program, GL_INFO_LOG_LENGTH, &length);
-  std::string log(std::size_t(std::max(length, 1)), '\0');
-  glGetProgramInfoLog(program, GLsizei(log.size()), nullptr, log.data());
-  log.resize(log.find('\0') == std::string::npos ? log.size() : log.find('\0'));
-  return log;
-}
+std::string shaderLog(GLuint shader) { return infoLog(shader, glGetShaderiv, glGetShaderInfoLog); }
+std::string programLog(GLuint program) { return infoLog(program, glGetProgramiv, glGetProgramInfoLog); }
 
 }  // namespace
 

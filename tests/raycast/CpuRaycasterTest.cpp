@@ -35,10 +35,6 @@ std::unique_ptr<FrameRenderer> cpuRenderer(const BrickStore& store, const Render
   return std::make_unique<FrameRenderer>(store, std::make_unique<CpuRaycaster>(), settings);
 }
 
-glm::dvec3 pixelRay(const Camera& camera, const RenderSettings& s, std::uint32_t x, std::uint32_t y) {
-  return camera.pixelRay(x, y, s.width, s.height);
-}
-
 TEST(CpuRaycaster, BallRendersAsDiskWithAnalyticDepth) {
   TempDir dir("ball");
   const testing::BallScene ball;
@@ -72,7 +68,7 @@ TEST_P(CpuRaycasterScenes, FindsTheNearestSphereOfABruteForce) {
   const int seed = GetParam();
   TempDir dir("cloud");
   const float extent = 80.0f;
-  const auto particles = testing::cloudParticles(6000, std::uint32_t(seed), extent);
+  const auto particles = testing::randomParticles(6000, std::uint32_t(seed), extent);
   BrickStore store = testing::makeStore(dir / "store", {particles}, extent, 32);
   RenderSettings settings = testing::smallSettings(96, 64);
   settings.radius = seed % 2 ? 1.4f : 0.9f;
@@ -99,7 +95,7 @@ TEST_P(CpuRaycasterScenes, FindsTheNearestSphereOfABruteForce) {
   for (std::uint32_t y = 0; y < settings.height; ++y) {
     for (std::uint32_t x = 0; x < settings.width; ++x) {
       const RayHit& hit = result.hits[y * settings.width + x];
-      const glm::vec3 dir(pixelRay(camera, settings, x, y));
+      const glm::vec3 dir(camera.pixelRay(x, y, settings.width, settings.height));
       const float expected = oracle.nearest(glm::vec3(camera.eye), dir);
       if ((expected >= 0) != (hit.status == kRayHit)) {
         ++mismatch;
@@ -150,7 +146,7 @@ TEST(CpuRaycaster, HitsCarryTheirCellsAttribute) {
 
 TEST(FrameRenderer, ColdFrameConvergesToTheWarmImageInOnePass) {
   TempDir dir("warm");
-  BrickStore store = testing::makeStore(dir / "store", {testing::cloudParticles(8000, 7, 64.0f)}, 64.0f, 32);
+  BrickStore store = testing::makeStore(dir / "store", {testing::randomParticles(8000, 7, 64.0f)}, 64.0f, 32);
   auto renderer = cpuRenderer(store, testing::smallSettings());
   const Camera camera = frameOnBox(renderer->frameBounds(0), 128.0 / 72.0);
   const RenderResult cold = renderer->render(0, camera);
@@ -166,7 +162,7 @@ TEST(FrameRenderer, ColdFrameConvergesToTheWarmImageInOnePass) {
 
 TEST(FrameRenderer, TinyPoolConvergesByEvictionToTheSameImage) {
   TempDir dir("tiny");
-  BrickStore store = testing::makeStore(dir / "store", {testing::cloudParticles(20000, 9, 96.0f)}, 96.0f, 32);
+  BrickStore store = testing::makeStore(dir / "store", {testing::randomParticles(20000, 9, 96.0f)}, 96.0f, 32);
   RenderSettings big = testing::smallSettings();
   RenderSettings tiny = big;
   tiny.gpuBudgetBytes = PoolLayout::forBudget(32, 1, false, 64ull << 20).slotBytes() * 3;

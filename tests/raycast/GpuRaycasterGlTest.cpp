@@ -73,7 +73,7 @@ TEST_P(GpuRaycasterScenes, EqualsTheCpuReference) {
   TempDir dir("gl-scene");
   const float extent = 96.0f;
   std::vector<glm::vec3> velocities;
-  auto particles = testing::cloudParticles(15000, std::uint32_t(seed), extent);
+  auto particles = testing::randomParticles(15000, std::uint32_t(seed), extent);
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> speed(-3, 3);
   for (std::size_t i = 0; i < particles.size(); ++i) velocities.push_back({speed(rng), speed(rng), speed(rng)});
@@ -97,7 +97,7 @@ INSTANTIATE_TEST_SUITE_P(RandomScenes, GpuRaycasterScenes, ::testing::Values(1, 
 
 TEST(GpuRaycaster, ColdConvergesToWarmAndATinyPoolByEviction) {
   TempDir dir("gl-loop");
-  BrickStore store = testing::makeStore(dir / "store", {testing::cloudParticles(20000, 9, 96.0f)}, 96.0f, 32);
+  BrickStore store = testing::makeStore(dir / "store", {testing::randomParticles(20000, 9, 96.0f)}, 96.0f, 32);
   RenderSettings settings = testing::smallSettings();
   GPU_RENDERER(renderer, store, settings);
   const Camera camera = frameOnBox(renderer->frameBounds(0), 128.0 / 72.0);

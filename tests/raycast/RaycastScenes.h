@@ -1,5 +1,6 @@
 // Small stores for ray-casting tests: a ball of particles (analytic silhouette and depth) and
-// random clustered clouds, binned with the real preprocess into a TempDir.
+// random clustered clouds (randomParticles of preprocess/VectorSource.h), binned with the real preprocess into a
+// TempDir.
 #pragma once
 
 #include <cmath>
@@ -40,11 +41,6 @@ inline std::vector<glm::vec3> ballParticles(glm::vec3 centre, float radius) {
         if (glm::length(p - centre) <= radius) out.push_back(p);
       }
   return out;
-}
-
-/// Clustered blobs and sparse spray in [0, extent)^3.
-inline std::vector<glm::vec3> cloudParticles(std::size_t n, std::uint32_t seed, float extent) {
-  return randomParticles(n, seed, extent);
 }
 
 inline RenderSettings smallSettings(std::uint32_t width = 128, std::uint32_t height = 72) {
