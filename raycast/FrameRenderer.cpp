@@ -83,27 +83,32 @@ FrameRenderer::FrameRenderer(BrickStore store, std::unique_ptr<RaycastDevice> de
 
 FrameRenderer::~FrameRenderer() = default;
 
-Box FrameRenderer::frameBounds(int frame) const {
-  const auto index = mStore.frame(frame);
+Box FrameRenderer::occupiedBounds(int first, int last) const {
   const StoreHeader& h = mStore.header();
-  if (index->bricks.empty()) return {};
+  std::vector<std::shared_ptr<const FrameIndex>> frames;
   glm::uvec3 lo(~0u), hi(0u);
-  for (const BrickRecord& record : index->bricks) {
-    lo = glm::min(lo, record.coord);
-    hi = glm::max(hi, record.coord);
+  for (int f = first; f <= last; ++f) {
+    frames.push_back(mStore.frame(f));
+    for (const BrickRecord& record : frames.back()->bricks) {
+      lo = glm::min(lo, record.coord);
+      hi = glm::max(hi, record.coord);
+    }
   }
-  // Bricks on the outer layers decide the bounds: decode them (up to a limit) for cell-exact
-  // bounds, so a default camera frames the fluid, not its 64-cell bricks.
+  if (lo.x > hi.x) return {};  // no bricks in any frame
+  // Bricks on the outer layers of all frames decide the bounds: decode them (up to a limit over
+  // the whole range) for cell-exact bounds, so a default camera frames the fluid, not its bricks.
   constexpr std::size_t kMaxDecoded = 2048;
-  std::vector<std::uint32_t> outer;
-  for (std::uint32_t i = 0; i < index->bricks.size(); ++i) {
-    const glm::uvec3 c = index->bricks[i].coord;
-    if (glm::any(glm::equal(c, lo)) || glm::any(glm::equal(c, hi))) outer.push_back(i);
+  std::vector<std::pair<const FrameIndex*, std::uint32_t>> outer;
+  for (const auto& index : frames) {
+    for (std::uint32_t i = 0; i < index->bricks.size(); ++i) {
+      const glm::uvec3 c = index->bricks[i].coord;
+      if (glm::any(glm::equal(c, lo)) || glm::any(glm::equal(c, hi))) outer.emplace_back(index.get(), i);
+    }
   }
   const glm::dvec3 lower(lo * h.brickSize), upper((hi + 1u) * h.brickSize);
   if (outer.size() > kMaxDecoded) return Box{h.origin + lower * h.cellSize, h.origin + upper * h.cellSize};
   glm::dvec3 cellMin(std::numeric_limits<double>::infinity()), cellMax(-std::numeric_limits<double>::infinity());
-  for (std::uint32_t i : outer) {
+  for (const auto& [index, i] : outer) {
     const DecodedBrick brick = mStore.readBrick(*index, i);
     const glm::dvec3 base(index->bricks[i].coord * h.brickSize);
     for (std::uint32_t cell : brick.cells) {

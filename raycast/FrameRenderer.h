@@ -75,9 +75,11 @@ class FrameRenderer {
   RaycastDevice& device() { return *mDevice; }
   const RenderSettings& settings() const { return mSettings; }
   const Streamer& streamer() const { return *mStreamer; }
-  /// World box of the frame's occupied cells (empty box for an empty frame); from the bricks
-  /// alone when more than a few thousand bricks form its outer layers.
-  Box frameBounds(int frame) const;
+  /// World box of the occupied cells of frames [first, last] (empty box when they hold no
+  /// brick). Cell-exact from the bricks on the outer layers, or brick-exact when more than a
+  /// few thousand bricks form them across the range.
+  Box occupiedBounds(int first, int last) const;
+  Box occupiedBounds(int frame) const { return occupiedBounds(frame, frame); }
   /// The parameter block of a pass (exposed for tests).
   RaycastParams params(const Camera& camera, const FrameIndex& frame) const;
 

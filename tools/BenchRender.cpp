@@ -123,7 +123,7 @@ void runBenchRender(const BenchRenderArgs& a) {
     const auto start = Clock::now();
     FrameRenderer renderer(BrickStore::open(storeDir), createRaycastDevice(choice), settings);
     deviceName = renderer.device().name();
-    const Camera camera = frameOnBox(renderer.frameBounds(0), double(width) / height, {0, 1, 0});
+    const Camera camera = frameOnBox(renderer.occupiedBounds(0), double(width) / height, {0, 1, 0});
     const RenderResult cold = renderer.render(0, camera);
     const double firstImage = secondsSince(start);
     writeImage(work / ("flipscope_" + std::to_string(width) + "x" + std::to_string(height) + ".png"),

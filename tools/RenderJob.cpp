@@ -54,8 +54,7 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
   if (job.camera) {
     camera = *job.camera;
   } else {
-    Box bounds;  // all frames, so a flipbook keeps one camera
-    for (int f = first; f <= last; ++f) bounds.extend(renderer.frameBounds(f));
+    Box bounds = renderer.occupiedBounds(first, last);  // all frames: a flipbook keeps one camera
     if (bounds.isEmpty()) bounds = Box{store.header().origin, store.header().domainMax()};
     camera = frameOnBox(bounds, double(job.settings.width) / job.settings.height, job.up);
   }

@@ -148,7 +148,7 @@ TEST(FrameRenderer, ColdFrameConvergesToTheWarmImageInOnePass) {
   TempDir dir("warm");
   BrickStore store = testing::makeStore(dir / "store", {testing::randomParticles(8000, 7, 64.0f)}, 64.0f, 32);
   auto renderer = cpuRenderer(store, testing::smallSettings());
-  const Camera camera = frameOnBox(renderer->frameBounds(0), 128.0 / 72.0);
+  const Camera camera = frameOnBox(renderer->occupiedBounds(0), 128.0 / 72.0);
   const RenderResult cold = renderer->render(0, camera);
   const RenderResult warm = renderer->render(0, camera);
   EXPECT_GT(cold.stats.passes, 1);
@@ -168,7 +168,7 @@ TEST(FrameRenderer, TinyPoolConvergesByEvictionToTheSameImage) {
   tiny.gpuBudgetBytes = PoolLayout::forBudget(32, 1, false, 64ull << 20).slotBytes() * 3;
   auto reference = cpuRenderer(store, big);
   auto starved = cpuRenderer(store, tiny);
-  const Camera camera = frameOnBox(reference->frameBounds(0), 128.0 / 72.0);
+  const Camera camera = frameOnBox(reference->occupiedBounds(0), 128.0 / 72.0);
   const RenderResult expected = reference->render(0, camera);
   const RenderResult result = starved->render(0, camera);
   ASSERT_TRUE(result.stats.converged);
@@ -184,7 +184,7 @@ TEST(FrameRenderer, RejectsMissingFramesAndBadSettings) {
   TempDir dir("bad");
   BrickStore store = testing::makeStore(dir / "store", {testing::ballParticles({20, 20, 20}, 5)}, 40.0f, 32);
   auto renderer = cpuRenderer(store, testing::smallSettings());
-  EXPECT_THROW(renderer->render(5, frameOnBox(renderer->frameBounds(0), 1.0)), InputError);
+  EXPECT_THROW(renderer->render(5, frameOnBox(renderer->occupiedBounds(0), 1.0)), InputError);
   RenderSettings settings = testing::smallSettings();
   settings.radius = 9;
   EXPECT_THROW(cpuRenderer(store, settings), InputError);

@@ -83,7 +83,7 @@ TEST_P(GpuRaycasterScenes, EqualsTheCpuReference) {
   settings.jitter = seed % 3 ? 0.4f : 0.0f;
   GPU_RENDERER(gpu, store, settings);
   FrameRenderer cpu(store, std::make_unique<CpuRaycaster>(), settings);
-  Camera camera = frameOnBox(cpu.frameBounds(0), double(settings.width) / settings.height);
+  Camera camera = frameOnBox(cpu.occupiedBounds(0), double(settings.width) / settings.height);
   camera.eye += glm::dvec3(seed * 7.0, -seed * 3.0, seed * 5.0);
   const RenderResult g = gpu->render(0, camera);
   const RenderResult c = cpu.render(0, camera);
@@ -100,7 +100,7 @@ TEST(GpuRaycaster, ColdConvergesToWarmAndATinyPoolByEviction) {
   BrickStore store = testing::makeStore(dir / "store", {testing::randomParticles(20000, 9, 96.0f)}, 96.0f, 32);
   RenderSettings settings = testing::smallSettings();
   GPU_RENDERER(renderer, store, settings);
-  const Camera camera = frameOnBox(renderer->frameBounds(0), 128.0 / 72.0);
+  const Camera camera = frameOnBox(renderer->occupiedBounds(0), 128.0 / 72.0);
   const RenderResult cold = renderer->render(0, camera);
   const RenderResult warm = renderer->render(0, camera);
   EXPECT_GT(cold.stats.passes, 1);
