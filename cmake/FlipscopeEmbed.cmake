@@ -3,7 +3,7 @@
 # directory. Each file becomes `extern const std::string_view <symbol>` in the generated header
 # `<target>_embedded.h` in namespace flipscope::embedded::<target>, symbol = file name with non-identifier characters replaced by '_'.
 # `#include "x.h"` lines inside a shader are resolved later, at run time, by ShaderSource
-# from the same embedded set (see raycast/gl/ShaderSource.h).
+# from the same embedded set (see gl/ShaderSource.h).
 function(flipscope_embed_text)
   cmake_parse_arguments(ARG "" "TARGET" "FILES" ${ARGN})
   set(_out_dir "${CMAKE_CURRENT_BINARY_DIR}/embedded")

@@ -5,7 +5,7 @@
 
 #include "core/Error.h"
 #include "raycast/CpuRaycaster.h"
-#include "raycast/gl/ShaderSource.h"
+#include "gl/ShaderSource.h"
 
 namespace flipscope {
 

@@ -6,8 +6,8 @@
 #include <memory>
 
 #include "raycast/RaycastDevice.h"
-#include "raycast/gl/EglContext.h"
-#include "raycast/gl/Objects.h"
+#include "gl/EglContext.h"
+#include "gl/Objects.h"
 
 namespace flipscope {
 

@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "core/Morton.h"
-#include "raycast/gl/EglContext.h"
-#include "raycast/gl/Objects.h"
-#include "raycast/gl/ShaderSource.h"
+#include "gl/EglContext.h"
+#include "gl/Objects.h"
+#include "gl/ShaderSource.h"
 #include "streaming/Jitter.h"
 
 namespace {

@@ -1,5 +1,5 @@
 // Move-only RAII wrappers of the OpenGL 4.5 objects the ray-caster needs (direct state access).
-// Every call needs a current context (raycast/gl/EglContext.h); destroy the objects before it.
+// Every call needs a current context (gl/EglContext.h); destroy the objects before it.
 // A default-constructed object is empty (id() == 0) except TimerQuery, which needs no arguments.
 // Misuse (out-of-range offsets, calls on empty objects) fails FLIPSCOPE_CHECK.
 #pragma once
@@ -67,7 +67,7 @@ class TimerQuery {
 class Program {
  public:
   Program() = default;
-  /// Compiles and links `source` (a complete GLSL source, see raycast/gl/ShaderSource.h).
+  /// Compiles and links `source` (a complete GLSL source, see gl/ShaderSource.h).
   /// Throws std::runtime_error with the info log and the numbered source when that fails;
   /// `name` starts the message.
   static Program compute(std::string_view source, std::string_view name = "compute shader");

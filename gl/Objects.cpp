@@ -1,4 +1,4 @@
-#include "raycast/gl/Objects.h"
+#include "gl/Objects.h"
 
 #include <algorithm>
 #include <cstdio>

@@ -1,15 +1,15 @@
-#include "raycast/gl/ShaderSource.h"
+#include "gl/ShaderSource.h"
 
 #include <set>
 #include <stdexcept>
 
-#include "flipscope_raycast_embedded.h"
+#include "flipscope_gl_embedded.h"
 
 namespace flipscope::gl {
 
 namespace {
 
-namespace embedded = flipscope::embedded::flipscope_raycast;
+namespace embedded = flipscope::embedded::flipscope_gl;
 
 const embedded::TextFile* findFile(std::string_view name) {
   for (const embedded::TextFile& file : embedded::kFiles)
@@ -67,10 +67,12 @@ void append(std::string& out, const embedded::TextFile& file, std::set<std::stri
 
 }  // namespace
 
-std::string shaderSource(std::string_view fileName) {
+std::string shaderSource(std::string_view fileName, std::string_view defines) {
   const embedded::TextFile* file = findFile(fileName);
   if (!file) throw std::runtime_error("unknown shader file \"" + std::string(fileName) + "\" (not embedded)");
   std::string out = "#version 450 core\n#define FS_FUNC\n";
+  out.append(defines);
+  if (!defines.empty() && defines.back() != '\n') out += '\n';
   std::set<std::string_view> pasted;
   append(out, *file, pasted);
   return out;

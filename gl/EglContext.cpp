@@ -1,4 +1,4 @@
-#include "raycast/gl/EglContext.h"
+#include "gl/EglContext.h"
 
 #include <epoxy/gl.h>
 

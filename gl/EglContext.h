@@ -7,7 +7,7 @@
 //  3. "default": eglGetDisplay(EGL_DEFAULT_DISPLAY);
 //  4. "device" again with software devices (EGL_MESA_device_software).
 // Builds with FLIPSCOPE_GL_DEBUG create a debug context and print GL errors and warnings to
-// stderr. Not thread safe; GL objects (raycast/gl/Objects.h) must be destroyed while their
+// stderr. Not thread safe; GL objects (gl/Objects.h) must be destroyed while their
 // context is alive and current.
 #pragma once
 

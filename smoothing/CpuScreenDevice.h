@@ -1,0 +1,37 @@
+// CpuScreenDevice: the C++ reference of the screen-space passes. Each pass runs its shared kernel
+// compiled as C++ (smoothing/detail/CpuScreenKernel.h) over images held in plain arrays, one TBB
+// task per band of rows.
+#pragma once
+
+#include <vector>
+
+#include "smoothing/ScreenDevice.h"
+
+namespace flipscope {
+
+class CpuScreenDevice : public ScreenDevice {
+ public:
+  std::string name() const override;
+  void setFrame(const ScreenFrame& frame) override;
+  ScreenImage createFrameImage(std::uint32_t perPixel = 1) override;
+  ScreenImage createFixedImage(std::size_t elements) override;
+  void upload(ScreenImage image, std::span<const glm::vec4> data) override;
+  std::vector<glm::vec4> download(ScreenImage image) override;
+  void clear(ScreenImage image) override;
+  void copy(ScreenImage from, ScreenImage to) override;
+  void run(const ScreenPass& pass, const void* params, std::size_t paramBytes,
+           std::initializer_list<ScreenImage> inputs, ScreenImage output) override;
+
+  /// The image's elements in place (no copy), for callers on the CPU.
+  std::span<glm::vec4> pixels(ScreenImage image);
+
+ private:
+  struct Image {
+    std::uint32_t perPixel = 0;  ///< 0: fixed size
+    std::vector<glm::vec4> data;
+  };
+  Image& image(ScreenImage handle);
+  std::vector<Image> mImages;
+};
+
+}  // namespace flipscope

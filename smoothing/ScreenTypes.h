@@ -1,0 +1,20 @@
+// C++ side of smoothing/glsl/ScreenTypes.glsl: the frame block of every screen-space pass,
+// defined once for C++ and GLSL, with its std140 layout checked here.
+#pragma once
+
+#include <cstddef>
+
+#include "core/GlslShared.h"
+
+namespace flipscope::glsl {
+#include "smoothing/glsl/ScreenTypes.glsl"
+}  // namespace flipscope::glsl
+
+namespace flipscope {
+using glsl::ScreenFrame;
+
+static_assert(sizeof(ScreenFrame) == 6 * 16);
+static_assert(offsetof(ScreenFrame, forward) == 16 && offsetof(ScreenFrame, worldUp) == 64 &&
+              offsetof(ScreenFrame, focalPixels) == 80 && offsetof(ScreenFrame, unused0) == 92);
+
+}  // namespace flipscope

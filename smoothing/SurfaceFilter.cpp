@@ -1,0 +1,96 @@
+// The filter registry: names, defaults and ranges of `--smoothing`, and the factories
+// (smoothing/detail/Filters.h). Adding a filter: one file with its factory, one row here.
+#include "smoothing/SurfaceFilter.h"
+
+#include <cmath>
+#include <functional>
+#include <sstream>
+
+#include "core/Error.h"
+#include "smoothing/detail/Filters.h"
+
+namespace flipscope {
+
+namespace {
+struct Entry {
+  SurfaceFilterInfo info;
+  std::function<std::unique_ptr<SurfaceFilter>(const SmoothingOptions&)> make;
+};
+
+const std::vector<Entry>& entries() {
+  static const std::vector<Entry> table = {
+      {{"rof", "adaptive ROF total-variation smoothing, Chambolle's projection (Reichl et al. 2014 Sec. 3.4)",
+        "k in lambda0 = k * focal length * radius^2: bumps lowered by about 2k particle radii", 75, 10000, 2.0f,
+        0.0f, 1000.0f},
+       detail::makeRofFilter},
+      {{"none", "no smoothing: the sphere depth as the ray-caster wrote it", "unused", 0, 0, 0.0f, 0.0f, 0.0f},
+       detail::makeNoFilter},
+  };
+  return table;
+}
+
+const Entry* find(const std::string& name) {
+  for (const Entry& entry : entries())
+    if (entry.info.name == name) return &entry;
+  return nullptr;
+}
+
+std::string formatNumber(float value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+}  // namespace
+
+const std::vector<SurfaceFilterInfo>& surfaceFilters() {
+  static const std::vector<SurfaceFilterInfo> infos = [] {
+    std::vector<SurfaceFilterInfo> list;
+    for (const Entry& entry : entries()) list.push_back(entry.info);
+    return list;
+  }();
+  return infos;
+}
+
+std::string surfaceFilterNames() {
+  std::string names;
+  for (const Entry& entry : entries()) names += (names.empty() ? "" : ", ") + std::string(entry.info.name);
+  return names;
+}
+
+SmoothingOptions resolve(const SmoothingOptions& options) {
+  const Entry* entry = find(options.name);
+  if (!entry)
+    throw InputError("--smoothing: unknown filter '" + options.name + "'; valid values: " + surfaceFilterNames());
+  const SurfaceFilterInfo& info = entry->info;
+  SmoothingOptions out = options;
+  if (out.iterations == -1) out.iterations = info.defaultIterations;
+  if (out.iterations < 0 || out.iterations > info.maxIterations)
+    throw InputError("--smoothing-iterations: " + std::to_string(out.iterations) + " is out of range for " +
+                     std::string(info.name) + "; valid values: " +
+                     (info.maxIterations == 0 ? std::string("0 (the filter has no iterations)")
+                                              : "0.." + std::to_string(info.maxIterations)));
+  if (out.strength == -1.0f) out.strength = info.defaultStrength;
+  if (!std::isfinite(out.strength) || out.strength < info.minStrength || out.strength > info.maxStrength)
+    throw InputError("--smoothing-strength: " + formatNumber(out.strength) + " is out of range for " +
+                     std::string(info.name) + " (" + std::string(info.strengthMeaning) +
+                     "); valid values: " + formatNumber(info.minStrength) + ".." + formatNumber(info.maxStrength));
+  return out;
+}
+
+std::unique_ptr<SurfaceFilter> createSurfaceFilter(const SmoothingOptions& options) {
+  const SmoothingOptions resolved = resolve(options);
+  return find(resolved.name)->make(resolved);
+}
+
+namespace detail {
+namespace {
+class NoFilter : public SurfaceFilter {
+ public:
+  void apply(ScreenDevice& device, ScreenImage depth, ScreenImage output) override { device.copy(depth, output); }
+};
+}  // namespace
+
+std::unique_ptr<SurfaceFilter> makeNoFilter(const SmoothingOptions&) { return std::make_unique<NoFilter>(); }
+}  // namespace detail
+
+}  // namespace flipscope

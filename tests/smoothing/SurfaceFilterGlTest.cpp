@@ -1,0 +1,64 @@
+// Every surface filter on the GPU (OpenGL compute, Mesa llvmpipe here) against its CPU reference,
+// on a roughened sphere in front of a plane at 128x72.
+#include <gtest/gtest.h>
+
+#include <memory>
+
+#include "gl/EglContext.h"
+#include "smoothing/GpuScreenDevice.h"
+#include "smoothing/SmoothingScenes.h"
+
+namespace flipscope {
+namespace {
+
+class SurfaceFilterGl : public ::testing::TestWithParam<std::string> {
+ protected:
+  void SetUp() override {
+    try {
+      mContext = gl::EglContext::create();
+    } catch (const gl::Unavailable& e) {
+      GTEST_SKIP() << "no EGL/OpenGL 4.5 device: " << e.what();
+    }
+  }
+  gl::EglContext mContext;
+};
+
+TEST_P(SurfaceFilterGl, GpuMatchesTheCpuReference) {
+  const testing::DepthScene scene = testing::sphereScene(128, 72, 1.0f, 3.0f, 0.8f, 5.0f);
+  const SmoothingOptions options{GetParam()};
+  const auto cpu = testing::smoothOnCpu(scene, options);
+  std::vector<glm::vec4> gpu;
+  {
+    GpuScreenDevice device("test");
+    device.setFrame(scene.frame);
+    const ScreenImage in = device.createFrameImage(), out = device.createFrameImage();
+    device.upload(in, scene.depth);
+    createSurfaceFilter(options)->apply(device, in, out);
+    gpu = device.download(out);
+  }
+  ASSERT_EQ(gpu.size(), cpu.size());
+  double worst = 0;
+  for (std::size_t i = 0; i < cpu.size(); ++i) {
+    ASSERT_EQ(gpu[i].y, cpu[i].y) << "mask differs at pixel " << i;
+    worst = std::max(worst, double(std::abs(gpu[i].x - cpu[i].x)));
+  }
+  // Depths are about 3 to 5 world units; float rounding and fused multiply-adds differ.
+  EXPECT_LT(worst, 2e-3) << GetParam();
+}
+
+std::vector<std::string> filterNames() {
+  std::vector<std::string> names;
+  for (const SurfaceFilterInfo& info : surfaceFilters()) names.emplace_back(info.name);
+  return names;
+}
+
+INSTANTIATE_TEST_SUITE_P(AllFilters, SurfaceFilterGl, ::testing::ValuesIn(filterNames()),
+                         [](const auto& info) {
+                           std::string name = info.param;
+                           for (char& c : name)
+                             if (c == '-') c = '_';
+                           return name;
+                         });
+
+}  // namespace
+}  // namespace flipscope
