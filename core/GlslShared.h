@@ -38,6 +38,16 @@ using glm::vec4;
 using std::abs;
 using std::floor;
 using std::sqrt;
+using glm::cross;
+using glm::exp;
+using glm::mix;
+using glm::pow;
+using glm::reflect;
+using glm::sign;
+using glm::acos;
+using glm::atan;
+using std::exp;
+using std::pow;
 
 inline int bitCount(uint v) { return std::popcount(v); }
 inline int findLSB(uint v) { return v == 0 ? -1 : std::countr_zero(v); }

@@ -20,7 +20,7 @@ namespace flipscope {
 namespace {
 
 constexpr char kStoreMagic[8] = {'F', 'S', 'S', 'T', 'O', 'R', 'E', '1'};
-constexpr std::size_t kStoreHeaderBytes = 8 + 4 + 4 + 8 + 24 + 12 + 4 + 8;
+constexpr std::size_t kStoreHeaderBytes = 8 + 4 + 4 + 8 + 24 + 12 + 4 + 8 + 8;
 
 bool isValidBrickSize(std::uint32_t b) { return b == 32 || b == 64 || b == 128; }
 
@@ -139,6 +139,7 @@ std::vector<std::byte> serializeStoreHeader(const StoreHeader& h) {
   w.put(h.brickGrid.y);
   w.put(h.brickGrid.z);
   w.put(static_cast<std::uint32_t>(h.attribute));
+  w.put(h.particleSpacing);
   w.put(checksum64(w.view()));
   FLIPSCOPE_CHECK(w.size() == kStoreHeaderBytes, w.size());
   return std::move(w.bytes());
@@ -152,7 +153,7 @@ StoreHeader parseStoreHeader(std::span<const std::byte> bytes, const std::filesy
   h.version = r.get<std::uint32_t>("version");
   if (h.version != kStoreVersion)
     r.fail("version", "unsupported store version " + std::to_string(h.version) + " (this flipscope reads version " +
-                          std::to_string(kStoreVersion) + ")");
+                          std::to_string(kStoreVersion) + "); convert the particle files again into a new store");
   h.brickSize = r.get<std::uint32_t>("brick size");
   h.cellSize = r.get<double>("cell size");
   h.origin.x = r.get<double>("origin x");
@@ -162,6 +163,7 @@ StoreHeader parseStoreHeader(std::span<const std::byte> bytes, const std::filesy
   h.brickGrid.y = r.get<std::uint32_t>("brick grid y");
   h.brickGrid.z = r.get<std::uint32_t>("brick grid z");
   auto attribute = r.get<std::uint32_t>("attribute");
+  h.particleSpacing = r.get<double>("particle spacing");
   const std::size_t checked = r.position();
   auto stored = r.get<std::uint64_t>("checksum");
   r.expectEnd("end of store header");
@@ -174,6 +176,7 @@ StoreHeader parseStoreHeader(std::span<const std::byte> bytes, const std::filesy
     if (h.brickGrid[a] == 0 || std::uint64_t(h.brickGrid[a]) * h.brickSize > 65536)
       throw FileError(file, "invalid brick grid");
   if (attribute > 1) throw FileError(file, "unknown attribute kind " + std::to_string(attribute));
+  if (!(std::isfinite(h.particleSpacing) && h.particleSpacing >= 0)) throw FileError(file, "invalid particle spacing");
   h.attribute = AttributeKind(attribute);
   return h;
 }

@@ -3,7 +3,7 @@
 // bricks from here, never the original particle files.
 //
 // A store is a directory:
-//   store.fsh               StoreHeader: format version, domain, cell size, brick size
+//   store.fsh               StoreHeader: format version, domain, cell size, brick size, particle spacing
 //   frame_NNNNNN.fsf        one file per frame: brick payloads, then octree, brick table, footer
 // Every file is written atomically (AtomicFile), so an interrupted convert leaves either no
 // frame file or a complete one; frames are appended by writing new frame files.
@@ -34,7 +34,8 @@
 
 namespace flipscope {
 
-inline constexpr std::uint32_t kStoreVersion = 1;
+/// 2: StoreHeader::particleSpacing. Stores of other versions are refused (convert again).
+inline constexpr std::uint32_t kStoreVersion = 2;
 inline constexpr char kStoreHeaderName[] = "store.fsh";
 
 /// The per-particle attribute a store carries, quantized to 16 bits over [min, max] of the frame.
@@ -50,6 +51,9 @@ struct StoreHeader {
   glm::dvec3 origin{0};               ///< world position of the domain's min corner
   glm::uvec3 brickGrid{0};            ///< bricks per axis (each < kMortonAxisLimit)
   AttributeKind attribute = AttributeKind::None;
+  /// World units: the particle spacing convert measured (ParticleSpacing.h), the cube root of
+  /// the volume per particle; 0 = unknown. Not part of the domain: appending keeps the store's.
+  double particleSpacing = 0;
 
   glm::dvec3 domainMax() const { return origin + glm::dvec3(brickGrid) * double(brickSize) * cellSize; }
   std::uint32_t cellsPerBrick() const { return brickSize * brickSize * brickSize; }

@@ -16,6 +16,7 @@
 #include "core/Error.h"
 #include "preprocess/BrickBinning.h"
 #include "preprocess/FrameFile.h"
+#include "preprocess/ParticleSpacing.h"
 
 namespace flipscope {
 namespace {
@@ -299,6 +300,64 @@ Box scanBounds(ParticleSource& source, std::size_t chunkParticles, Progress* pro
   return bounds;
 }
 
+std::string formatNumber(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
+/// The particle spacing of the first frame; of the next ones (up to 4 frames) while unknown.
+SpacingEstimate measureSpacing(const std::vector<FrameInput>& inputs, const ConvertOptions& options) {
+  SpacingEstimate estimate;
+  for (std::size_t i = 0; i < std::min<std::size_t>(inputs.size(), 4); ++i) {
+    auto source = openFrame(inputs[i], options.read);
+    const std::string frame = "frame " + std::to_string(inputs[i].frame);
+    std::optional<Progress> progress;  // the metadata estimate reads nothing
+    if (!source->spacingHint()) progress.emplace("particle spacing of " + frame, 0, "particles", options.progress);
+    estimate = estimateParticleSpacing(*source, progress ? &*progress : nullptr);
+    if (progress) progress->finish();
+    estimate.origin = frame + ": " + estimate.origin;
+    if (estimate.known()) break;
+  }
+  return estimate;
+}
+
+/// The header of a new store: the cell size as ConvertOptions documents it.
+StoreHeader chooseHeader(const Box& bounds, const ConvertOptions& options, bool attribute,
+                         const SpacingEstimate& spacing, ConvertReport& report) {
+  ConvertOptions o = options;
+  o.particleSpacing = spacing.spacing;
+  report.spacingOrigin = spacing.origin;
+  if (options.cellSize) {
+    report.cellSizeOrigin = "--cell-size";
+    return makeStoreHeader(bounds, o, attribute);
+  }
+  if (options.resolution) {
+    report.cellSizeOrigin = std::to_string(*options.resolution) + " cells along the longest axis";
+    return makeStoreHeader(bounds, o, attribute);
+  }
+  const std::string fallback =
+      "; using " + std::to_string(kDefaultResolution) + " cells along the longest axis instead";
+  if (spacing.known()) {
+    const glm::dvec3 extent = bounds.isEmpty() ? glm::dvec3(0) : bounds.extent();
+    const double longest = std::max({extent.x, extent.y, extent.z});
+    const double cells = std::floor(longest / spacing.spacing) + 1;
+    if (cells <= kMaxCellsPerAxis) {
+      o.cellSize = spacing.spacing;
+      report.cellSizeOrigin = "one cell per particle spacing";
+      return makeStoreHeader(bounds, o, attribute);
+    }
+    report.warnings.push_back("one cell per particle spacing (" + formatNumber(spacing.spacing) +
+                              ") would make the domain " + formatNumber(cells) + " cells long, more than " +
+                              std::to_string(kMaxCellsPerAxis) + fallback);
+  } else {
+    report.warnings.push_back("the particle spacing is unknown (" + spacing.origin + ")" + fallback);
+  }
+  o.resolution = kDefaultResolution;
+  report.cellSizeOrigin = std::to_string(kDefaultResolution) + " cells along the longest axis (default)";
+  return makeStoreHeader(bounds, o, attribute);
+}
+
 }  // namespace
 
 StoreHeader makeStoreHeader(const Box& bounds, const ConvertOptions& options, bool attribute) {
@@ -311,11 +370,15 @@ StoreHeader makeStoreHeader(const Box& bounds, const ConvertOptions& options, bo
   if (options.cellSize) {
     cellSize = *options.cellSize;
   } else {
-    if (options.resolution == 0) throw InputError("resolution must be positive");
-    cellSize = longest > 0 ? longest / options.resolution : 1.0;
+    const std::uint32_t resolution = options.resolution.value_or(kDefaultResolution);
+    if (resolution == 0) throw InputError("resolution must be positive");
+    cellSize = longest > 0 ? longest / resolution : 1.0;
   }
   if (!(std::isfinite(cellSize) && cellSize > 0)) throw InputError("cell size must be a positive number");
+  const double spacing = options.particleSpacing.value_or(0);
+  if (!(std::isfinite(spacing) && spacing >= 0)) throw InputError("particle spacing must be a positive number or 0");
   StoreHeader h;
+  h.particleSpacing = spacing;
   h.brickSize = options.brickSize;
   h.cellSize = cellSize;
   h.origin = bounds.min;
@@ -374,22 +437,35 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
   const bool wantAttribute = options.attribute.value_or(allVelocity);
   if (wantAttribute && !allVelocity) throw InputError("--attribute speed needs velocities in every input file");
 
+  ConvertReport report;
   StoreHeader header;
   if (BrickStore::exists(storeDir)) {
     header = BrickStore::open(storeDir).header();
-  } else if (options.domain) {
-    header = makeStoreHeader(*options.domain, options, wantAttribute);
+    report.cellSizeOrigin = "kept from the existing store";
+    report.spacingOrigin = "the existing store";
   } else {
-    Progress progress("scan bounds", hinted, "particles", options.progress);
+    SpacingEstimate spacing;
+    if (options.particleSpacing) {
+      spacing.spacing = *options.particleSpacing;
+      spacing.origin = spacing.spacing > 0 ? "given" : "not measured";
+      if (!(std::isfinite(spacing.spacing) && spacing.spacing >= 0))
+        throw InputError("particle spacing must be a positive number or 0");
+    } else {
+      spacing = measureSpacing(inputs, options);
+    }
     Box bounds;
-    const MemoryPlan plan(options.memoryBudget, false);
-    for (const auto& input : inputs) bounds.extend(scanBounds(*openFrame(input, options.read), plan.chunkParticles, &progress));
-    progress.finish();
-    header = makeStoreHeader(bounds, options, wantAttribute);
+    if (options.domain) {
+      bounds = *options.domain;
+    } else {
+      Progress progress("scan bounds", hinted, "particles", options.progress);
+      const MemoryPlan plan(options.memoryBudget, false);
+      for (const auto& input : inputs)
+        bounds.extend(scanBounds(*openFrame(input, options.read), plan.chunkParticles, &progress));
+      progress.finish();
+    }
+    header = chooseHeader(bounds, options, wantAttribute, spacing, report);
   }
   BrickStore store = BrickStore::createOrAppend(storeDir, header);
-
-  ConvertReport report;
   report.header = store.header();
   Progress progress("convert", hinted, "particles", options.progress);
   for (std::size_t i = 0; i < inputs.size(); ++i) {

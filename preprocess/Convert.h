@@ -13,11 +13,18 @@
 //
 // Oddities are counted, reported (FrameStats) and skipped: NaN/Inf coordinates, particles
 // outside `domain`.
+//
+// Cell size: --cell-size, else longest domain axis / --resolution, else (neither given) one cell
+// per particle spacing of the first frame (ParticleSpacing.h), falling back to
+// kDefaultResolution cells along the longest axis, with a warning, when the spacing is unknown
+// or the grid would exceed kMaxCellsPerAxis. The spacing is measured and recorded in the
+// store header either way (StoreHeader::particleSpacing).
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "core/Box.h"
@@ -30,11 +37,17 @@ namespace flipscope {
 
 inline constexpr std::uint64_t kDefaultMemoryBudget = 4ull << 30;
 inline constexpr std::uint32_t kMaxCellsPerAxis = 65536;
+inline constexpr std::uint32_t kDefaultResolution = 1024;
 
 struct ConvertOptions {
   std::optional<Box> domain;           ///< world units; default: bounds of all frames (an extra read pass)
   std::optional<double> cellSize;      ///< world units; default: longest domain axis / resolution
-  std::uint32_t resolution = 1024;     ///< cells along the longest axis when cellSize is unset
+  /// Cells along the longest axis when cellSize is unset. Unset too: convert() makes one cell
+  /// per particle spacing, makeStoreHeader() uses kDefaultResolution.
+  std::optional<std::uint32_t> resolution;
+  /// World units; default: measured on the first frame (estimateParticleSpacing: free for
+  /// OpenVDB points, one or two extra reads of the frame for other sources).
+  std::optional<double> particleSpacing;
   std::uint32_t brickSize = 64;        ///< 32, 64 or 128
   std::uint64_t memoryBudget = kDefaultMemoryBudget;  ///< bytes
   std::optional<bool> attribute;       ///< store speed; default: when every input has velocities
@@ -56,6 +69,12 @@ struct FrameReport {
 struct ConvertReport {
   StoreHeader header;
   std::vector<FrameReport> frames;
+  /// How the cell size was chosen, e.g. "particle spacing (OpenVDB grid ...)", "--cell-size".
+  std::string cellSizeOrigin;
+  /// How header.particleSpacing was found, or why it is unknown (0).
+  std::string spacingOrigin;
+  /// Worth telling the user (e.g. the fallback from the particle spacing to kDefaultResolution).
+  std::vector<std::string> warnings;
 };
 
 /// Converts every frame of `inputs` into the store at `storeDir` (created, or appended to:
@@ -63,8 +82,10 @@ struct ConvertReport {
 ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesystem::path& storeDir,
                       const ConvertOptions& options = {});
 
-/// The store header for particles within `bounds`. Throws InputError when the grid would
-/// exceed kMaxCellsPerAxis cells or the cell size is not positive.
+/// The store header for particles within `bounds` (particleSpacing from the options, else 0):
+/// cell size options.cellSize, else longest axis / options.resolution (default
+/// kDefaultResolution). Throws InputError when the grid would exceed kMaxCellsPerAxis cells or
+/// the cell size is not positive.
 StoreHeader makeStoreHeader(const Box& bounds, const ConvertOptions& options, bool attribute);
 
 /// Bins one frame read from `source` into `store` (lower-level step of convert()).

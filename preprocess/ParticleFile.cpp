@@ -62,6 +62,19 @@ class ConcatenatedSource final : public ParticleSource {
     for (auto& part : mParts) part->rewind();
     mCurrent = 0;
   }
+  /// Only when every part has a hint: the parts' volumes and points add up.
+  std::optional<SpacingHint> spacingHint() const override {
+    SpacingHint total;
+    for (const auto& part : mParts) {
+      auto hint = part->spacingHint();
+      if (!hint) return std::nullopt;
+      total.volume += hint->volume;
+      total.points += hint->points;
+      total.origin += (total.origin.empty() ? "" : " + ") + hint->origin;
+    }
+    if (mParts.empty()) return std::nullopt;
+    return total;
+  }
 
  private:
   std::vector<std::unique_ptr<ParticleSource>> mParts;

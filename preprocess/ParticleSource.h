@@ -27,6 +27,15 @@ struct ParticleChunk {
   std::size_t size() const { return positions.size(); }
 };
 
+/// What a file's own metadata says about its particle spacing (ParticleSpacing.h): `points`
+/// particles fill `volume` world units^3 (OpenVDB points: the active voxels of the grids).
+/// Hints of several sources add up (volumes and points).
+struct SpacingHint {
+  double volume = 0;
+  std::uint64_t points = 0;
+  std::string origin;  ///< for messages, e.g. "OpenVDB grid 'particles': 14554 points in 3431 voxels of 0.0625"
+};
+
 class ParticleSource {
  public:
   virtual ~ParticleSource() = default;
@@ -42,6 +51,9 @@ class ParticleSource {
   virtual bool read(ParticleChunk& chunk, std::size_t maxParticles) = 0;
   /// Starts over from the first particle (multi-pass conversion: bounds, then binning).
   virtual void rewind() = 0;
+  /// The particle spacing as the file's metadata tells it without reading the particles, else
+  /// nullopt (then estimateParticleSpacing() measures neighbour distances).
+  virtual std::optional<SpacingHint> spacingHint() const { return std::nullopt; }
 };
 
 struct ReadOptions {

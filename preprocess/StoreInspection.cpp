@@ -25,6 +25,10 @@ FrameSummary summarizeFrame(const FrameIndex& frame, const StoreHeader& header) 
   return s;
 }
 
+double spacingInCells(const StoreHeader& header) {
+  return header.particleSpacing > 0 && header.cellSize > 0 ? header.particleSpacing / header.cellSize : 0;
+}
+
 std::vector<std::string> verifyFrame(const BrickStore& store, const FrameIndex& frame) {
   std::vector<std::string> errors;
   std::mutex mutex;

@@ -24,6 +24,9 @@ struct FrameSummary {
 
 FrameSummary summarizeFrame(const FrameIndex& frame, const StoreHeader& header);
 
+/// The particle spacing the store recorded, in cells of the store (0 when unknown).
+double spacingInCells(const StoreHeader& header);
+
 /// Reads every brick of `frame`, checks its checksum and decodes it. Returns one message per
 /// damaged brick (naming the file and the brick); empty when the frame is intact. Parallel.
 std::vector<std::string> verifyFrame(const BrickStore& store, const FrameIndex& frame);

@@ -104,7 +104,11 @@ class VdbPointsReader final : public ParticleSource {
     rethrowAsFileError(mPath, [&] {
       loadGrids();
       std::uint64_t count = 0;
-      for (const auto& g : mGrids) count += openvdb::points::pointCount(g.grid->tree());
+      for (const auto& g : mGrids) {
+        const std::uint64_t points = openvdb::points::pointCount(g.grid->tree());
+        count += points;
+        addSpacingHint(g, points);
+      }
       mCount = count;
     });
     bool any = false;
@@ -120,6 +124,12 @@ class VdbPointsReader final : public ParticleSource {
   std::string name() const override { return mPath.string(); }
   bool hasVelocity() const override { return mHasVelocity; }
   std::optional<std::uint64_t> countHint() const override { return mCount; }
+  /// Particles per active voxel of the topology (no attribute is read): a FLIP solver's
+  /// points grid has a voxel per simulation cell, and its particles fill the active ones.
+  std::optional<SpacingHint> spacingHint() const override {
+    if (mSpacing.points == 0 || !(mSpacing.volume > 0) || !std::isfinite(mSpacing.volume)) return std::nullopt;
+    return mSpacing;
+  }
 
   bool read(ParticleChunk& chunk, std::size_t maxParticles) override {
     FLIPSCOPE_CHECK(maxParticles > 0);
@@ -170,6 +180,17 @@ class VdbPointsReader final : public ParticleSource {
       mGrids.push_back(std::move(g));
     }
     file.close();
+  }
+
+  void addSpacingHint(const PointGrid& g, std::uint64_t points) {
+    const std::uint64_t active = g.grid->tree().activeVoxelCount();
+    if (points == 0 || active == 0) return;
+    mSpacing.volume += double(active) * g.grid->transform().voxelVolume();
+    mSpacing.points += points;
+    std::ostringstream text;
+    text << (mSpacing.origin.empty() ? "OpenVDB grid '" : ", grid '") << g.grid->getName() << "': " << points
+         << " points in " << active << " active voxels of " << g.grid->transform().voxelSize()[0];
+    mSpacing.origin += text.str();
   }
 
   /// Rejects files that are not OpenVDB before OpenVDB parses them.
@@ -242,6 +263,7 @@ class VdbPointsReader final : public ParticleSource {
   ReadOptions mOptions;
   std::vector<PointGrid> mGrids;
   std::uint64_t mCount = 0;
+  SpacingHint mSpacing;
   bool mHasVelocity = false;
   std::size_t mGrid = 0;
   std::size_t mLeaf = 0;

@@ -107,7 +107,7 @@ std::vector<std::uint32_t> CpuRaycaster::trace(const RaycastParams& params) {
     for (std::uint32_t y = rows.begin(); y != rows.end(); ++y) {
       for (std::uint32_t x = 0; x < mWidth; ++x) {
         RayHit& ray = mHits[std::size_t(y) * mWidth + x];
-        if (ray.status == kRayPending) ray = local.rcTrace(glm::uvec2(x, y), ray);
+        if (local.rcNeedsPass(ray)) ray = local.rcPass(glm::uvec2(x, y), ray);
       }
     }
   });

@@ -22,6 +22,8 @@ class CpuRaycaster : public RaycastDevice {
   std::vector<std::uint32_t> trace(const RaycastParams& params) override;
   double lastTraceMs() const override { return mLastTraceMs; }
   std::vector<RayHit> readHits() override { return mHits; }
+  /// The image's rays in place, for the passes after the ray-caster.
+  const std::vector<RayHit>& hits() const { return mHits; }
 
   /// The pool's arrays, laid out as the GPU's buffers. Slots are left uninitialized until a
   /// brick is uploaded (the page table never points at an empty slot), so a large budget costs

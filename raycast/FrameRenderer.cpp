@@ -26,6 +26,14 @@ std::uint32_t sphereReach(float radius, float jitter) {
   return std::uint32_t(std::ceil(double(radius) + double(jitter) + 0.5) - 1.0);
 }
 
+float defaultSphereRadius(const StoreHeader& header, float jitter) {
+  if (!(header.particleSpacing > 0) || !(header.cellSize > 0)) return 1.0f;
+  float radius = std::max(1.0f, float(header.particleSpacing / header.cellSize));
+  // The largest radius whose reach fits the border: reach = ceil(radius + jitter + 0.5) - 1.
+  const float largest = float(kMaxOverlap) + 0.5f - jitter;
+  return std::min(radius, std::max(largest, 0.5f));
+}
+
 void validate(const RenderSettings& s) {
   if (s.width == 0 || s.height == 0 || s.width > 16384 || s.height > 16384)
     throw InputError("--size: width and height must be in 1..16384, got " + std::to_string(s.width) + "x" +
@@ -154,6 +162,18 @@ std::vector<std::uint32_t> FrameRenderer::pageTable(const FrameIndex& frame) con
 }
 
 RenderResult FrameRenderer::render(int frame, const Camera& camera, int direction) {
+  RenderResult result;
+  result.frame = frame;
+  result.width = mSettings.width;
+  result.height = mSettings.height;
+  result.stats = trace(frame, camera, direction);
+  const auto start = Clock::now();
+  result.hits = mDevice->readHits();
+  result.stats.totalMs += msSince(start);
+  return result;
+}
+
+RenderStats FrameRenderer::trace(int frame, const Camera& camera, int direction) {
   const auto start = Clock::now();
   validate(camera, "camera");
   if (!mStore.hasFrame(frame))
@@ -161,11 +181,7 @@ RenderResult FrameRenderer::render(int frame, const Camera& camera, int directio
   const auto index = mStore.frame(frame);
   const StoreHeader& header = mStore.header();
 
-  RenderResult result;
-  result.frame = frame;
-  result.width = mSettings.width;
-  result.height = mSettings.height;
-  RenderStats& stats = result.stats;
+  RenderStats stats;
   stats.frameBricks = index->bricks.size();
   stats.poolBytes = mPool.layout().bytes();
 
@@ -176,7 +192,7 @@ RenderResult FrameRenderer::render(int frame, const Camera& camera, int directio
   mDevice->setOctree(index->octree.nodes);
   mDevice->setPageTable(pages);
   mDevice->beginImage(mSettings.width, mSettings.height);
-  const RaycastParams params = this->params(camera, *index);
+  RaycastParams params = this->params(camera, *index);
 
   std::vector<BrickKey> evicted;
   for (stats.passes = 1;; ++stats.passes) {
@@ -229,7 +245,12 @@ RenderResult FrameRenderer::render(int frame, const Camera& camera, int directio
       const auto placement = mPool.place(brick->key, brick->bits.attributes.size(), batch, evicted);
       for (const BrickKey& key : evicted) {
         ++stats.bricksEvicted;
-        if (key.frame == frame) pages[std::size_t(index->octree.find(key.coord))] = kNotResident;
+        if (key.frame != frame) continue;
+        pages[std::size_t(index->octree.find(key.coord))] = kNotResident;
+        // The pool cannot hold what this frame needs at once: thickness behind a hit becomes
+        // best effort, so the bricks of hits and of thickness marches cannot evict each other
+        // forever. Hits stay exact.
+        params.sphere.z = 1.0f;
       }
       if (!placement) break;  // the pool holds this pass's bricks only: the rest next pass
       mDevice->uploadBrick(placement->slot, placement->attributeOffset, *brick);
@@ -239,10 +260,9 @@ RenderResult FrameRenderer::render(int frame, const Camera& camera, int directio
     mDevice->setPageTable(pages);
     stats.uploadMs += msSince(uploadStart);
   }
-  result.hits = mDevice->readHits();
   stats.bricksResident = mPool.resident();
   stats.totalMs = msSince(start);
-  return result;
+  return stats;
 }
 
 }  // namespace flipscope

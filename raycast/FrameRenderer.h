@@ -39,6 +39,11 @@ struct RenderSettings {
 void validate(const RenderSettings& settings);
 /// Cells around a cell whose spheres can reach it: ceil(radius + jitter + 0.5) - 1.
 std::uint32_t sphereReach(float radius, float jitter);
+/// The sphere radius in cells a render takes when none is given: one particle spacing of the
+/// store (StoreHeader::particleSpacing), so neighbouring particles' spheres overlap and a
+/// liquid body renders closed; at least 1 cell, at most what the overlap border allows with
+/// `jitter`; 1 cell when the store records no spacing.
+float defaultSphereRadius(const StoreHeader& header, float jitter);
 
 struct RenderStats {
   int passes = 0;
@@ -70,6 +75,9 @@ class FrameRenderer {
   /// Renders `frame` (InputError when the store has no such frame). `direction` (+1, -1, 0)
   /// steers the Streamer's read-ahead.
   RenderResult render(int frame, const Camera& camera, int direction = 0);
+  /// render() without reading the hits back: they stay on the device for the screen-space
+  /// stages (pipeline/FramePipeline.h).
+  RenderStats trace(int frame, const Camera& camera, int direction = 0);
 
   const BrickStore& store() const { return mStore; }
   RaycastDevice& device() { return *mDevice; }

@@ -30,6 +30,9 @@ class GpuRaycaster : public RaycastDevice {
   std::vector<std::uint32_t> trace(const RaycastParams& params) override;
   double lastTraceMs() const override { return mLastTraceMs; }
   std::vector<RayHit> readHits() override;
+  /// The image's rays on the device (RayHit array, row 0 at the top), for the passes after the
+  /// ray-caster; the object stays the same across images (its storage is reallocated on resize).
+  const gl::Buffer& hitBuffer() const { return mHits; }
 
  private:
   gl::EglContext mContext;

@@ -23,6 +23,8 @@ namespace flipscope {
 namespace {
 
 constexpr const char* kNormalChannels[3] = {"N.X", "N.Y", "N.Z"};
+constexpr const char* kUnsmoothedDepthChannel = "unsmoothed.Z";
+constexpr const char* kThicknessChannel = "thickness";
 
 std::size_t pixelCount(const RenderImage& image) { return std::size_t(image.width) * image.height; }
 
@@ -34,6 +36,10 @@ void checkImage(const RenderImage& image) {
   FLIPSCOPE_CHECK(image.depth.empty() || image.depth.size() == n, "depth=" << image.depth.size() << " pixels=" << n);
   FLIPSCOPE_CHECK(image.normal.empty() || image.normal.size() == n,
                   "normal=" << image.normal.size() << " pixels=" << n);
+  FLIPSCOPE_CHECK(image.unsmoothedDepth.empty() || image.unsmoothedDepth.size() == n,
+                  "unsmoothedDepth=" << image.unsmoothedDepth.size() << " pixels=" << n);
+  FLIPSCOPE_CHECK(image.thickness.empty() || image.thickness.size() == n,
+                  "thickness=" << image.thickness.size() << " pixels=" << n);
 }
 
 /// Runs `write` and turns any failure into a FileError naming `path`.
@@ -118,11 +124,15 @@ void writeExr(const std::filesystem::path& path, const RenderImage& image) {
     frame.insert(kRgba[c], Imf::Slice(Imf::HALF, reinterpret_cast<char*>(rgba.data() + c), 4 * sizeof(Imath::half),
                                       4 * sizeof(Imath::half) * width));
   }
-  if (!image.depth.empty()) {
-    header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
-    frame.insert("Z", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(image.depth.data())),
-                                 sizeof(float), sizeof(float) * width));
-  }
+  auto insertFloat = [&](const char* name, const std::vector<float>& values) {
+    if (values.empty()) return;
+    header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+    frame.insert(name, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(values.data())),
+                                  sizeof(float), sizeof(float) * width));
+  };
+  insertFloat("Z", image.depth);
+  insertFloat(kUnsmoothedDepthChannel, image.unsmoothedDepth);
+  insertFloat(kThicknessChannel, image.thickness);
   if (!image.normal.empty()) {
     char* base = reinterpret_cast<char*>(const_cast<glm::vec3*>(image.normal.data()));
     for (int c = 0; c < 3; ++c) {
@@ -213,10 +223,14 @@ ExrContents readExr(const std::filesystem::path& path) {
     for (int c = 0; c < 4; ++c)
       frame.insert(kRgba[c], Imf::Slice::Make(Imf::FLOAT, &image.rgba[0][c], window, sizeof(glm::vec4), 0, 1, 1,
                                               c == 3 ? 1.0 : 0.0));
-    if (has("Z")) {
-      image.depth.assign(n, 0.0f);
-      frame.insert("Z", Imf::Slice::Make(Imf::FLOAT, image.depth.data(), window, sizeof(float)));
-    }
+    auto readFloat = [&](const char* name, std::vector<float>& values) {
+      if (!has(name)) return;
+      values.assign(n, 0.0f);
+      frame.insert(name, Imf::Slice::Make(Imf::FLOAT, values.data(), window, sizeof(float)));
+    };
+    readFloat("Z", image.depth);
+    readFloat(kUnsmoothedDepthChannel, image.unsmoothedDepth);
+    readFloat(kThicknessChannel, image.thickness);
     if (has(kNormalChannels[0]) && has(kNormalChannels[1]) && has(kNormalChannels[2])) {
       image.normal.assign(n, glm::vec3(0.0f));
       for (int c = 0; c < 3; ++c)

@@ -3,8 +3,9 @@
 // sees the old file or the complete new one, never a partial one.
 //
 // EXR channels: R G B A (HALF, linear, premultiplied), Z (FLOAT, camera depth in world units,
-// +inf where nothing was hit) and N.X N.Y N.Z (FLOAT, world-space normal, 0 where nothing was
-// hit). The normal is a layer "N" in the OpenEXR "layer.channel" naming: Nuke splits at the
+// +inf where nothing was hit; the smoothed surface's), unsmoothed.Z (FLOAT, the sphere depth
+// before smoothing), thickness (FLOAT, liquid along the ray behind the surface, world units) and
+// N.X N.Y N.Z (FLOAT, world-space normal, 0 where nothing was hit). The normal is a layer "N" in the OpenEXR "layer.channel" naming: Nuke splits at the
 // first '.', shows layer N with channels X, Y, Z (only R/G/B/A suffixes are renamed to
 // red/green/blue/alpha), and sorts them in x, y, z order; Houdini's EXR reader groups the
 // N.* channels into one vector plane N; OpenImageIO keeps X, Y, Z in that order as spatial data.
@@ -27,9 +28,12 @@ struct RenderImage {
   std::vector<glm::vec4> rgba;    ///< linear RGB, premultiplied alpha; width * height
   std::vector<float> depth;       ///< camera depth, world units, +inf where alpha is 0; empty or width * height
   std::vector<glm::vec3> normal;  ///< world-space unit normal, 0 where nothing was hit; empty or width * height
+  std::vector<float> unsmoothedDepth;  ///< like depth, before smoothing; empty or width * height
+  std::vector<float> thickness;        ///< world units, 0 where nothing was hit; empty or width * height
 };
 
-/// Writes R G B A (HALF), Z and N.X N.Y N.Z (FLOAT; each only when its vector is not empty),
+/// Writes R G B A (HALF), Z, unsmoothed.Z, thickness and N.X N.Y N.Z (FLOAT; each only when its
+/// vector is not empty),
 /// ZIP compressed. Throws FileError naming `path`.
 void writeExr(const std::filesystem::path& path, const RenderImage& image);
 
@@ -46,7 +50,7 @@ void writeImage(const std::filesystem::path& path, const RenderImage& image);
 
 /// What readExr found: every channel name of the file (in the file's, alphabetical, order) and
 /// the image. Missing R, G, B read as 0 and a missing A as 1; depth and normal stay empty
-/// unless the file has Z, or N.X, N.Y and N.Z.
+/// unless the file has Z, or N.X, N.Y and N.Z; unsmoothedDepth and thickness likewise.
 struct ExrContents {
   std::vector<std::string> channels;
   RenderImage image;

@@ -16,6 +16,7 @@ using glsl::kNotResident;
 using glsl::kRayHit;
 using glsl::kRayMiss;
 using glsl::kRayPending;
+using glsl::kThicknessCells;
 using glsl::RaycastParams;
 using glsl::RayHit;
 
@@ -23,9 +24,9 @@ using glsl::RayHit;
 static_assert(sizeof(RaycastParams) == 17 * 16);
 static_assert(offsetof(RaycastParams, image) == 64 && offsetof(RaycastParams, sphere) == 128 &&
               offsetof(RaycastParams, mipLevels) == 144);
-static_assert(sizeof(RayHit) == 32);
+static_assert(sizeof(RayHit) == 48 && sizeof(RayHit) % sizeof(glm::vec4) == 0, "a RayHit is three vec4 (pipeline/glsl)");
 static_assert(kRayPending == 0, "a zeroed RayHit is a fresh pending ray");
 static_assert(offsetof(RayHit, t) == 16 && offsetof(RayHit, status) == 20 && offsetof(RayHit, depth) == 24 &&
-              offsetof(RayHit, brickIndex) == 28);
+              offsetof(RayHit, brickIndex) == 28 && offsetof(RayHit, thickness) == 32);
 
 }  // namespace flipscope

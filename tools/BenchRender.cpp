@@ -18,7 +18,7 @@
 #include "preprocess/ParticleWriter.h"
 #include "preprocess/SynthFluid.h"
 #include "raycast/GpuRaycaster.h"
-#include "raycast/Shading.h"
+#include "pipeline/FramePipeline.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
 
@@ -121,13 +121,14 @@ void runBenchRender(const BenchRenderArgs& a) {
     settings.gpuBudgetBytes = parseBytes("--gpu-mem", a.gpuMem);
     // Cold: everything a first image needs, from opening the store.
     const auto start = Clock::now();
-    FrameRenderer renderer(BrickStore::open(storeDir), createRaycastDevice(choice), settings);
-    deviceName = renderer.device().name();
-    const Camera camera = frameOnBox(renderer.occupiedBounds(0), double(width) / height, {0, 1, 0});
-    const RenderResult cold = renderer.render(0, camera);
+    BrickStore store = BrickStore::open(storeDir);
+    settings.radius = defaultSphereRadius(store.header(), settings.jitter);
+    FramePipeline pipeline(std::move(store), choice, settings, SurfaceSettings{});
+    deviceName = pipeline.deviceName();
+    const Camera camera = frameOnBox(pipeline.renderer().occupiedBounds(0), double(width) / height, {0, 1, 0});
+    const FrameOutput cold = pipeline.render(0, camera);
     const double firstImage = secondsSince(start);
-    writeImage(work / ("flipscope_" + std::to_string(width) + "x" + std::to_string(height) + ".png"),
-               shade(cold, camera));
+    writeImage(work / ("flipscope_" + std::to_string(width) + "x" + std::to_string(height) + ".png"), cold.image);
     // Warm: an orbit of small steps around the target (bricks resident, one pass each).
     double frameMs = 0, traceMs = 0;
     int warmPasses = 0;
@@ -138,7 +139,7 @@ void runBenchRender(const BenchRenderArgs& a) {
       orbit.eye = camera.target + glm::dvec3(offset.x * std::cos(angle) - offset.z * std::sin(angle), offset.y,
                                              offset.x * std::sin(angle) + offset.z * std::cos(angle));
       const auto t = Clock::now();
-      const RenderResult warm = renderer.render(0, orbit);
+      const FrameOutput warm = pipeline.render(0, orbit);
       frameMs += secondsSince(t) * 1e3 / a.orbitFrames;
       traceMs += warm.stats.traceMs / a.orbitFrames;
       warmPasses = std::max(warmPasses, warm.stats.passes);

@@ -19,7 +19,7 @@ struct ConvertArgs {
   std::string frames;
   std::vector<std::string> grids;
   double cellSize = 0;
-  std::uint32_t resolution = 1024;
+  std::uint32_t resolution = 0;  ///< 0: not given
   std::uint32_t brickSize = 64;
   std::string domain;
   std::string mem = "4G";
@@ -32,7 +32,7 @@ struct ConvertArgs {
 void runConvert(const ConvertArgs& a) {
   ConvertOptions options;
   if (a.cellSize != 0) options.cellSize = a.cellSize;
-  options.resolution = a.resolution;
+  if (a.resolution != 0) options.resolution = a.resolution;
   options.brickSize = a.brickSize;
   if (!a.domain.empty()) options.domain = parseBox("--domain", a.domain);
   options.memoryBudget = parseBytes("--mem", a.mem);
@@ -50,11 +50,18 @@ void runConvert(const ConvertArgs& a) {
   if (!a.frames.empty()) range = parseFrameRange(a.frames);
   const auto inputs = expandInputs(a.inputs, range);
   const ConvertReport report = convert(inputs, a.store, options);
+  for (const auto& warning : report.warnings) std::fprintf(stderr, "warning: %s\n", warning.c_str());
 
   if (a.quiet) return;
   const StoreHeader& h = report.header;
-  std::printf("store %s: cell size %g, bricks of %u^3, grid %ux%ux%u bricks, attribute %s\n", a.store.c_str(),
-              h.cellSize, h.brickSize, h.brickGrid.x, h.brickGrid.y, h.brickGrid.z, attributeName(h.attribute));
+  std::printf("store %s: cell size %g (%s), bricks of %u^3, grid %ux%ux%u bricks, attribute %s\n", a.store.c_str(),
+              h.cellSize, report.cellSizeOrigin.c_str(), h.brickSize, h.brickGrid.x, h.brickGrid.y, h.brickGrid.z,
+              attributeName(h.attribute));
+  if (h.particleSpacing > 0)
+    std::printf("particle spacing %g (%.2f cells), from %s\n", h.particleSpacing, h.particleSpacing / h.cellSize,
+                report.spacingOrigin.c_str());
+  else
+    std::printf("particle spacing unknown (%s)\n", report.spacingOrigin.c_str());
   for (const auto& f : report.frames) {
     std::printf("  frame %d: %llu particles, %u bricks, %s bytes, %.2f s%s", f.frame,
                 (unsigned long long)f.stats.particles, f.bricks, Progress::humanCount(double(f.storeBytes)).c_str(),
@@ -78,10 +85,13 @@ void addConvertCommand(CLI::App& app) {
   cmd->add_option("-o,--output", args->store, "Brick store directory (created, or appended to)")->required();
   cmd->add_option("--frames", args->frames, "Frame range A-B for patterns (default: every frame found)");
   cmd->add_option("--grid", args->grids, "VDB: PointDataGrid names to read (default: all)");
-  auto* cell = cmd->add_option("--cell-size", args->cellSize, "Cell size in world units")->check(CLI::PositiveNumber);
-  cmd->add_option("--resolution", args->resolution, "Cells along the longest domain axis (if no --cell-size)")
-      ->excludes(cell)
-      ->capture_default_str();
+  auto* cell = cmd->add_option("--cell-size", args->cellSize, "Cell size in world units (default: see --resolution)")
+                   ->check(CLI::PositiveNumber);
+  cmd->add_option("--resolution", args->resolution,
+                  "Cells along the longest domain axis (default: one cell per particle spacing, measured on the "
+                  "first frame; 1024 when it cannot be)")
+      ->check(CLI::PositiveNumber)
+      ->excludes(cell);
   cmd->add_option("--brick-size", args->brickSize, "Cells per brick edge")
       ->check(CLI::IsMember({32, 64, 128}))
       ->capture_default_str();

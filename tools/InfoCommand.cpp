@@ -57,6 +57,9 @@ void runInfo(const InfoArgs& a) {
     j["version"] = h.version;
     j["brick_size"] = h.brickSize;
     j["cell_size"] = h.cellSize;
+    // world units and cells of the store; null when the store does not know it
+    j["particle_spacing"] = h.particleSpacing > 0 ? nlohmann::json(h.particleSpacing) : nlohmann::json(nullptr);
+    j["particle_spacing_cells"] = h.particleSpacing > 0 ? nlohmann::json(spacingInCells(h)) : nlohmann::json(nullptr);
     j["origin"] = {h.origin.x, h.origin.y, h.origin.z};
     j["brick_grid"] = {h.brickGrid.x, h.brickGrid.y, h.brickGrid.z};
     j["attribute"] = attributeName(h.attribute);
@@ -87,6 +90,11 @@ void runInfo(const InfoArgs& a) {
     std::printf("store      %s (version %u)\n", a.store.c_str(), h.version);
     std::printf("domain     origin (%g, %g, %g), cell size %g, %ux%ux%u bricks of %u^3 cells\n", h.origin.x, h.origin.y,
                 h.origin.z, h.cellSize, h.brickGrid.x, h.brickGrid.y, h.brickGrid.z, h.brickSize);
+    if (h.particleSpacing > 0)
+      std::printf("spacing    particle spacing %g = %.2f cells of %g\n", h.particleSpacing, spacingInCells(h),
+                  h.cellSize);
+    else
+      std::printf("spacing    particle spacing unknown (cell size %g)\n", h.cellSize);
     std::printf("attribute  %s\n\n", attributeName(h.attribute));
     std::printf("%7s %14s %9s %8s %10s %12s %9s\n", "frame", "particles", "bricks", "fill", "bits/part", "bytes",
                 "raw/store");

@@ -1,4 +1,5 @@
-// flipscope render: brick store frames -> EXR (R G B A Z N.*) or PNG previews, headless.
+// flipscope render: brick store frames -> EXR (R G B A Z unsmoothed.Z thickness N.*) or PNG
+// previews of the smoothed, shaded liquid surface, headless.
 #include <CLI/CLI.hpp>
 
 #include <memory>
@@ -8,6 +9,8 @@
 #include "preprocess/InputSequence.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
+#include "smoothing/SurfaceFilter.h"
+#include "smoothing/SurfaceShading.h"
 #include "tools/RenderJob.h"
 
 namespace flipscope::tools {
@@ -22,7 +25,12 @@ struct RenderArgs {
   std::string camera;
   std::string cameraFile;
   std::string up = "y";
-  float radius = 1.0f;
+  std::optional<float> radius;
+  std::string smoothing = "rof";
+  std::optional<int> smoothingIterations;
+  std::optional<float> smoothingStrength;
+  std::string shading = "liquid";
+  std::string environment;
   std::string jitter = "on";
   std::string gpuMem = "1G";
   std::string cpuMem = "2G";
@@ -61,7 +69,21 @@ void runRender(const RenderArgs& a) {
     job.lastFrame = range.last;
   }
   std::tie(job.settings.width, job.settings.height) = parseImageSize("--size", a.size);
-  job.settings.radius = a.radius;
+  job.radius = a.radius;
+  if (a.radius) {
+    job.settings.radius = *a.radius;
+    validate(job.settings);
+  }
+  job.surface.smoothing.name = a.smoothing;
+  job.surface.smoothing.iterations = a.smoothingIterations.value_or(-1);
+  job.surface.smoothing.strength = a.smoothingStrength.value_or(-1.0f);
+  if (a.smoothingIterations && *a.smoothingIterations < 0)
+    throw InputError("--smoothing-iterations: must be 0 or more, got " + std::to_string(*a.smoothingIterations));
+  if (a.smoothingStrength && !(*a.smoothingStrength >= 0))
+    throw InputError("--smoothing-strength: must be 0 or more, got " + std::to_string(*a.smoothingStrength));
+  job.surface.smoothing = resolve(job.surface.smoothing);
+  job.surface.shading.mode = parseShadingMode(a.shading);
+  job.surface.environment = a.environment;
   job.settings.jitter = parseJitter(a.jitter);
   job.settings.gpuBudgetBytes = parseBytes("--gpu-mem", a.gpuMem);
   job.settings.cpuCacheBytes = parseBytes("--cpu-mem", a.cpuMem);
@@ -79,7 +101,7 @@ void runRender(const RenderArgs& a) {
 
 void addRenderCommand(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
-  auto* cmd = app.add_subcommand("render", "Render brick store frames headless to EXR (R G B A Z N) or PNG");
+  auto* cmd = app.add_subcommand("render", "Render brick store frames headless to EXR (R G B A Z N thickness) or PNG");
   cmd->add_option("store", args->store, "Brick store directory")->required();
   cmd->add_option("-o,--output", args->output, "Output .exr or .png; '####' takes the frame number")->required();
   auto* frame = cmd->add_option("--frame", args->frame, "Frame to render (default: the first)");
@@ -90,7 +112,16 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--camera-file", args->cameraFile, "JSON {\"eye\", \"target\", \"up\", \"fov\"}")->excludes(camera);
   cmd->add_option("--up", args->up, "Up axis of the default camera framed on the data (x, y or z)")
       ->capture_default_str();
-  cmd->add_option("--radius", args->radius, "Sphere radius in cells")->capture_default_str();
+  cmd->add_option("--radius", args->radius,
+                  "Sphere radius in cells (default: the store's particle spacing, at least 1 cell)");
+  cmd->add_option("--smoothing", args->smoothing, "Surface filter: " + surfaceFilterNames())->capture_default_str();
+  cmd->add_option("--smoothing-iterations", args->smoothingIterations,
+                  "Filter iterations (default: the filter's; see README, Smoothing)");
+  cmd->add_option("--smoothing-strength", args->smoothingStrength,
+                  "Filter strength: lambda0 in particle radii for rof, the filter's size for the others");
+  cmd->add_option("--shading", args->shading, "liquid, spheres (lit spheres) or attribute (colour by attribute)")
+      ->capture_default_str();
+  cmd->add_option("--env", args->environment, "Equirectangular EXR environment (default: procedural sky and ground)");
   cmd->add_option("--jitter", args->jitter, "Per-cell jitter: on (0.25 cells), off, or cells")->capture_default_str();
   cmd->add_option("--gpu-mem", args->gpuMem, "Brick pool budget on the device")->capture_default_str();
   cmd->add_option("--cpu-mem", args->cpuMem, "Converted-brick cache in CPU memory")->capture_default_str();

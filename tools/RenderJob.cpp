@@ -5,7 +5,6 @@
 #include "core/Error.h"
 #include "core/Progress.h"
 #include "raycast/ImageWriter.h"
-#include "raycast/Shading.h"
 
 namespace flipscope::tools {
 
@@ -42,13 +41,20 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
     throw InputError("-o: rendering frames " + std::to_string(first) + "-" + std::to_string(last) +
                      " needs '#' in the output name (e.g. out_####.exr)");
 
+  RenderSettings settings = job.settings;
+  settings.radius = job.radius.value_or(defaultSphereRadius(store.header(), settings.jitter));
+  SurfaceSettings surface = job.surface;
+  surface.up = job.up;
   std::string fallback;
-  auto device = createRaycastDevice(job.device, &fallback);
+  FramePipeline pipeline(store, job.device, settings, surface, &fallback);
+  FrameRenderer& renderer = pipeline.renderer();
   if (!job.quiet) {
-    if (!fallback.empty()) std::fprintf(stderr, "render: using the CPU reference ray-caster: %s\n", fallback.c_str());
-    std::printf("render: %s\n", device->name().c_str());
+    if (!fallback.empty()) std::fprintf(stderr, "render: using the CPU reference: %s\n", fallback.c_str());
+    const SmoothingOptions& smoothing = resolve(surface.smoothing);
+    std::printf("render: %s; sphere radius %.3g cells%s; smoothing %s (%d iterations, strength %g)\n",
+                pipeline.deviceName().c_str(), settings.radius, job.radius ? "" : " (from the store's particle spacing)",
+                smoothing.name.c_str(), smoothing.iterations, smoothing.strength);
   }
-  FrameRenderer renderer(store, std::move(device), job.settings);
 
   Camera camera;
   if (job.camera) {
@@ -56,26 +62,28 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
   } else {
     Box bounds = renderer.occupiedBounds(first, last);  // all frames: a flipbook keeps one camera
     if (bounds.isEmpty()) bounds = Box{store.header().origin, store.header().domainMax()};
-    camera = frameOnBox(bounds, double(job.settings.width) / job.settings.height, job.up);
+    camera = frameOnBox(bounds, double(settings.width) / settings.height, job.up);
   }
 
   std::vector<RenderedFile> files;
   for (int f = first; f <= last; ++f) {
-    const RenderResult result = renderer.render(f, camera, last > first ? 1 : 0);
+    const FrameOutput result = pipeline.render(f, camera, last > first ? 1 : 0);
     const std::string path = outputPathForFrame(job.output, f);
-    writeImage(path, shade(result, camera));
+    writeImage(path, result.image);
     const RenderStats& s = result.stats;
+    const StageTimes& t = result.stages;
     if (!job.quiet) {
       std::printf(
           "  frame %d: %ux%u, %d %s%s; bricks: %llu requested, %llu uploaded, %zu resident (pool %sB), "
-          "%zu in the frame; %.0f ms (trace %.0f, stream %.0f, upload %.0f) -> %s\n",
-          f, result.width, result.height, s.passes, s.passes == 1 ? "pass" : "passes",
+          "%zu in the frame; %.0f ms (trace %.0f, stream %.0f, upload %.0f; smoothing %.0f, normals %.0f, "
+          "shading %.0f) -> %s\n",
+          f, result.image.width, result.image.height, s.passes, s.passes == 1 ? "pass" : "passes",
           s.converged ? "" : " (pass limit: not converged)", (unsigned long long)s.bricksRequested,
           (unsigned long long)s.bricksUploaded, s.bricksResident, Progress::humanCount(double(s.poolBytes)).c_str(),
-          s.frameBricks, s.totalMs, s.traceMs, s.streamMs, s.uploadMs, path.c_str());
+          s.frameBricks, t.total, s.traceMs, s.streamMs, s.uploadMs, t.smoothing, t.normals, t.shading, path.c_str());
       std::fflush(stdout);
     }
-    files.push_back({f, path, s});
+    files.push_back({f, path, s, t});
   }
   return files;
 }

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/FramePipeline.h"
 #include "raycast/Camera.h"
 #include "raycast/FrameRenderer.h"
 #include "raycast/GpuRaycaster.h"
@@ -17,7 +18,9 @@ struct RenderJob {
   std::string output;             ///< .exr or .png; '#' runs take the zero-padded frame number
   std::optional<int> firstFrame;  ///< default: the store's first frame
   std::optional<int> lastFrame;   ///< inclusive; default: firstFrame
-  RenderSettings settings;
+  RenderSettings settings;       ///< settings.radius is replaced by `radius`
+  std::optional<float> radius;   ///< sphere radius in cells; default: defaultSphereRadius(store)
+  SurfaceSettings surface;       ///< smoothing and shading; surface.up is set from `up`
   std::optional<Camera> camera;  ///< default: framed on the frames' bricks
   glm::dvec3 up{0, 1, 0};        ///< up axis of the default camera
   DeviceChoice device = DeviceChoice::Auto;
@@ -28,6 +31,7 @@ struct RenderedFile {
   int frame;
   std::string path;
   RenderStats stats;
+  StageTimes stages;
 };
 
 /// Renders every frame of the job (frames missing from the store are an InputError naming the

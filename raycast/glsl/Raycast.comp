@@ -42,6 +42,6 @@ void main() {
   if (pixel.x >= P.image.x || pixel.y >= P.image.y) return;
   uint index = pixel.y * P.image.x + pixel.x;
   RayHit ray = hits[index];
-  if (ray.status != kRayPending) return;
-  hits[index] = rcTrace(pixel, ray);
+  if (!rcNeedsPass(ray)) return;
+  hits[index] = rcPass(pixel, ray);
 }

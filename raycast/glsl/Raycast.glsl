@@ -162,6 +162,54 @@ FS_FUNC RayHit rcTraceBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec
   return result;
 }
 
+// Index of `brick` (brick-grid coordinates inside the grid) in the frame's brick table, or
+// kNotResident when the presence octree has no such brick.
+FS_FUNC uint rcBrickIndex(uvec3 brick) {
+  uint levels = P.brick.z;
+  uint node = 0u;
+  uvec3 origin = uvec3(0u);
+  for (uint level = 0u; level < levels; level++) {
+    uint halfSize = 1u << (levels - 1u - level);
+    uvec3 octant = uvec3(brick.x - origin.x >= halfSize ? 1u : 0u, brick.y - origin.y >= halfSize ? 1u : 0u,
+                         brick.z - origin.z >= halfSize ? 1u : 0u);
+    uint child = octant.x | (octant.y << 1u) | (octant.z << 2u);
+    uvec2 n = rcNode(node);
+    origin += octant * uvec3(halfSize);
+    if (((n.x >> child) & 1u) == 0u) return kNotResident;
+    node = n.y + uint(bitCount(n.x & ((1u << child) - 1u)));
+  }
+  return node;
+}
+
+// Thickness of the liquid behind a hit at tHit (§3.6): x = the set cells met at unit steps along
+// the ray over the next kThicknessCells cells; y = kNotResident, or the index of a brick on the
+// way that is not resident (x is then incomplete). With P.sphere.z = 1 (best effort) bricks that
+// are not resident count as empty and y is always kNotResident.
+FS_FUNC uvec2 rcThickness(vec3 eye, vec3 dir, float tHit) {
+  int B = int(P.grid.w);
+  ivec3 gridCells = ivec3(int(P.grid.x), int(P.grid.y), int(P.grid.z)) * B;
+  bool bestEffort = P.sphere.z > 0.5f;
+  ivec3 current = ivec3(-1);
+  uint slot = kNotResident;
+  uint occupied = 0u;
+  for (uint i = 0u; i < kThicknessCells; i++) {
+    vec3 p = eye + (tHit + 0.5f + float(i)) * dir;
+    ivec3 cell = ivec3(floor(p));
+    if (cell.x < 0 || cell.y < 0 || cell.z < 0 || cell.x >= gridCells.x || cell.y >= gridCells.y ||
+        cell.z >= gridCells.z)
+      break;
+    ivec3 brick = cell / B;
+    if (brick.x != current.x || brick.y != current.y || brick.z != current.z) {
+      current = brick;
+      uint index = rcBrickIndex(uvec3(brick));
+      slot = index == kNotResident ? kNotResident : rcPage(index);
+      if (index != kNotResident && slot == kNotResident && !bestEffort) return uvec2(occupied, index);
+    }
+    if (slot != kNotResident && rcCellSet(slot, cell - brick * B)) occupied++;
+  }
+  return uvec2(occupied, kNotResident);
+}
+
 // Continues `ray` (pending, from ray.t) for `pixel` until it hits, misses, or stops at a brick
 // that is not resident (then requested). A ray that exhausts kRaycastMaxSteps is a miss.
 FS_FUNC RayHit rcTrace(uvec2 pixel, RayHit ray) {
@@ -231,4 +279,35 @@ FS_FUNC RayHit rcTrace(uvec2 pixel, RayHit ray) {
     t = rcStepPast(max(brickExit, t));
   }
   return result;
+}
+
+// Fills in the thickness of a hit `ray` (status kRayHit) for `pixel`: the bricks behind the hit
+// must be resident; a missing one is requested and the thickness stays -1 (unknown), so the
+// next pass comes back to it. The hit itself is final.
+FS_FUNC RayHit rcResolveThickness(uvec2 pixel, RayHit ray) {
+  RayHit result = ray;
+  vec3 eye = vec3(P.eye.x, P.eye.y, P.eye.z);
+  uvec2 thickness = rcThickness(eye, rcCameraRay(pixel), ray.t);
+  if (thickness.y != kNotResident) {
+    rcRequest(thickness.y);
+    result.thickness = -1.0f;
+  } else {
+    result.thickness = float(thickness.x) * P.up.w;
+  }
+  return result;
+}
+
+// Whether a pass still has work for `ray`: a pending ray, or a hit whose thickness is unknown.
+FS_FUNC bool rcNeedsPass(RayHit ray) {
+  return ray.status == kRayPending || (ray.status == kRayHit && ray.thickness < 0.0f);
+}
+
+// One pass of the ray of `pixel`: continues a pending ray (rcTrace), or resolves a hit's thickness.
+FS_FUNC RayHit rcPass(uvec2 pixel, RayHit ray) {
+  if (ray.status == kRayPending) {
+    RayHit traced = rcTrace(pixel, ray);
+    if (traced.status == kRayHit) return rcResolveThickness(pixel, traced);
+    return traced;
+  }
+  return rcResolveThickness(pixel, ray);
 }

@@ -16,7 +16,9 @@ struct RaycastParams {
   uvec4 grid;    // xyz: bricks per axis; w: cells per brick edge B
   uvec4 brick;   // x: overlap n; y: neighbourhood k; z: octree levels; w: sub-bricks per slot
   uvec4 pool;    // x: mip words per slot; y: 1 with attributes; z: bricks in the frame; w: mip levels
-  vec4 sphere;   // x: radius in cells; y: max jitter in cells; z, w: unused
+  vec4 sphere;   // x: radius in cells; y: max jitter in cells; z: 1 = thickness best effort
+                 // (bricks behind a hit that are not resident count as empty), 0 = request them;
+                 // w: unused
   uvec4 mipLevels[8];  // level k (1..pool.w) at k - 1: xyz blocks per axis, w word offset
 };
 
@@ -34,8 +36,15 @@ struct RayHit {
   float depth;     // linear camera depth in world units (t * cellSize * dot(dir, forward))
   uint brickIndex; // brick of the hit, or the brick a pending ray waits for (0 before the first
                    // pass), kNotResident on a miss
+  float thickness; // liquid along the ray behind the hit, world units: set cells met in the
+                   // kThicknessCells cells after it, times the cell size (§3.6); -1 while the
+                   // bricks it needs are not resident
+  float unused0;
+  float unused1;
+  float unused2;
 };
 
 const uint kNotResident = 0xffffffffu;
 const uint kMaxMipLevels = 8u;  // 144 stored cells (128 + 2 x 8) make 7
 const uint kRaycastMaxSteps = 65536u;  // bound on each traversal loop of one ray in one pass
+const uint kThicknessCells = 48u;      // cells behind a hit sampled for its thickness

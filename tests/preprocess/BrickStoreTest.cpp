@@ -4,10 +4,13 @@
 
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 
 #include "core/AtomicFile.h"
+#include "core/Bytes.h"
 #include "core/Error.h"
+#include "core/Hash.h"
 #include "preprocess/BrickStore.h"
 #include "preprocess/Convert.h"
 #include "TestSupport.h"
@@ -77,8 +80,11 @@ TEST(StoreHeader, RoundTripsAndRejectsEveryCorruption) {
   h.origin = {-1, 2, 3.5};
   h.brickGrid = {4, 5, 6};
   h.attribute = AttributeKind::Speed;
+  h.particleSpacing = 0.0625;
   auto bytes = serializeStoreHeader(h);
   StoreHeader back = parseStoreHeader(bytes, "store.fsh");
+  EXPECT_EQ(back.version, kStoreVersion);
+  EXPECT_EQ(back.particleSpacing, h.particleSpacing);
   EXPECT_EQ(back.brickSize, h.brickSize);
   EXPECT_EQ(back.cellSize, h.cellSize);
   EXPECT_EQ(back.origin, h.origin);
@@ -107,6 +113,55 @@ TEST(StoreHeader, NamesAnUnknownVersion) {
     FAIL();
   } catch (const FileError& e) {
     EXPECT_NE(std::string(e.what()).find("unsupported store version 7"), std::string::npos) << e.what();
+  }
+}
+
+TEST(StoreHeader, UnknownSpacingIsZeroAndANegativeOneIsRefused) {
+  StoreHeader h;
+  h.cellSize = 1;
+  h.brickGrid = {1, 1, 1};
+  EXPECT_EQ(parseStoreHeader(serializeStoreHeader(h), "store.fsh").particleSpacing, 0.0);
+  h.particleSpacing = -0.5;
+  EXPECT_THROW(parseStoreHeader(serializeStoreHeader(h), "store.fsh"), FileError);
+  h.particleSpacing = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(parseStoreHeader(serializeStoreHeader(h), "store.fsh"), FileError);
+}
+
+TEST(BrickStore, VersionOneStoreIsRefusedAskingToConvertAgain) {
+  // store.fsh as flipscope wrote it before the particle spacing (version 1, 72 bytes).
+  ByteWriter w;
+  w.append("FSSTORE1", 8);
+  w.put(std::uint32_t(1));   // version
+  w.put(std::uint32_t(64));  // brick size
+  w.put(0.05);               // cell size
+  for (double o : {0.0, 0.0, 0.0}) w.put(o);
+  for (std::uint32_t g : {2u, 2u, 2u}) w.put(g);
+  w.put(std::uint32_t(0));  // attribute
+  w.put(checksum64(w.view()));
+  ASSERT_EQ(w.size(), 72u);
+  testing::TempDir temp("v1");
+  const fs::path dir = temp / "store";
+  fs::create_directories(dir);
+  {
+    std::ofstream out(dir / kStoreHeaderName, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(w.view().data()), std::streamsize(w.size()));
+  }
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    try {
+      if (attempt == 0) {
+        BrickStore::open(dir);
+      } else {  // appending to it is refused the same way
+        ConvertOptions options;
+        options.cellSize = 0.05;
+        BrickStore::createOrAppend(dir, makeStoreHeader(Box{{0, 0, 0}, {1, 1, 1}}, options, false));
+      }
+      FAIL() << "opened a version 1 store";
+    } catch (const FileError& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("store.fsh"), std::string::npos) << message;
+      EXPECT_NE(message.find("unsupported store version 1"), std::string::npos) << message;
+      EXPECT_NE(message.find("convert the particle files again"), std::string::npos) << message;
+    }
   }
 }
 

@@ -12,6 +12,8 @@
 #include "core/Morton.h"
 #include "preprocess/BrickBinning.h"
 #include "preprocess/Convert.h"
+#include "preprocess/ParticleSpacing.h"
+#include "preprocess/ParticleWriter.h"
 #include "TestSupport.h"
 #include "VectorSource.h"
 
@@ -195,6 +197,104 @@ TEST(Convert, DomainIsDerivedFromTheBoundsAndLimited) {
   options.cellSize = 1e-6;
   EXPECT_THROW(makeStoreHeader(Box{{0, 0, 0}, {1, 1, 1}}, options, false), InputError);
   EXPECT_THROW(makeStoreHeader(Box{}, ConvertOptions{}, false), InputError);
+}
+
+fs::path mantaflowFrame30() { return fs::path(FLIPSCOPE_DATA_DIR) / "mantaflow-dam64" / "data" / "fluid_data_0030.vdb"; }
+
+void writeRaw(const fs::path& path, const std::vector<glm::vec3>& positions) {
+  auto writer = createParticleWriter(path);
+  ParticleChunk chunk;
+  chunk.positions = positions;
+  writer->write(chunk);
+  writer->commit();
+}
+
+/// n^3 particles, `spacing` apart, from `origin`.
+std::vector<glm::vec3> latticePoints(int n, float spacing, glm::vec3 origin = glm::vec3(0)) {
+  std::vector<glm::vec3> points;
+  for (int x = 0; x < n; ++x)
+    for (int y = 0; y < n; ++y)
+      for (int z = 0; z < n; ++z) points.push_back(origin + spacing * glm::vec3(x, y, z));
+  return points;
+}
+
+ConvertOptions silent() {
+  ConvertOptions options;
+  options.progress = Progress::Mode::Silent;
+  return options;
+}
+
+TEST(ConvertSpacing, DefaultConvertOfMantaflowMakesOneCellPerParticleSpacing) {
+  const fs::path file = mantaflowFrame30();
+  ASSERT_TRUE(fs::exists(file)) << file;
+  testing::TempDir temp("spacing");
+  const ConvertReport report = convert({{30, {file}}}, temp / "store", silent());
+  const StoreHeader& h = report.header;
+  EXPECT_GT(h.particleSpacing, 0.0);
+  EXPECT_EQ(h.cellSize, h.particleSpacing);
+  auto source = openParticleFile(file);
+  EXPECT_EQ(h.particleSpacing, estimateParticleSpacing(*source).spacing);  // the OpenVDB metadata estimate
+  EXPECT_NE(report.cellSizeOrigin.find("particle spacing"), std::string::npos) << report.cellSizeOrigin;
+  EXPECT_NE(report.spacingOrigin.find("frame 30: OpenVDB grid 'particles'"), std::string::npos) << report.spacingOrigin;
+  EXPECT_TRUE(report.warnings.empty());
+  ASSERT_EQ(report.frames.size(), 1u);
+  EXPECT_EQ(report.frames[0].stats.particles, source->countHint());
+  // Recorded in store.fsh.
+  const StoreHeader reopened = BrickStore::open(temp / "store").header();
+  EXPECT_EQ(reopened.particleSpacing, h.particleSpacing);
+  EXPECT_EQ(reopened.cellSize, h.cellSize);
+  // Appending keeps the store's cell size and spacing.
+  const ConvertReport again = convert({{31, {file}}}, temp / "store", silent());
+  EXPECT_EQ(again.header.particleSpacing, h.particleSpacing);
+  EXPECT_EQ(again.header.cellSize, h.cellSize);
+}
+
+TEST(ConvertSpacing, GivenCellSizeOrResolutionStillRecordsTheSpacing) {
+  testing::TempDir temp("spacing-given");
+  const fs::path raw = temp / "lattice.bin";
+  writeRaw(raw, latticePoints(30, 0.2f, {1, 2, 3}));  // no metadata: the neighbour estimate
+  ConvertOptions options = silent();
+  options.cellSize = 0.5;
+  const ConvertReport a = convert({{0, {raw}}}, temp / "a", options);
+  EXPECT_EQ(a.header.cellSize, 0.5);
+  EXPECT_NEAR(a.header.particleSpacing, 0.2, 0.2 * 0.03);
+  EXPECT_EQ(a.cellSizeOrigin, "--cell-size");
+
+  options = silent();
+  options.resolution = 50;
+  const ConvertReport b = convert({{0, {raw}}}, temp / "b", options);
+  EXPECT_NEAR(b.header.cellSize, 29 * 0.2 / 50, 1e-6);
+  EXPECT_EQ(b.header.particleSpacing, a.header.particleSpacing);
+
+  const ConvertReport c = convert({{0, {raw}}}, temp / "c", silent());
+  EXPECT_EQ(c.header.cellSize, a.header.particleSpacing);
+  EXPECT_NE(c.spacingOrigin.find("12th-neighbour"), std::string::npos) << c.spacingOrigin;
+
+  options = silent();
+  options.particleSpacing = 0.25;  // known to the caller: nothing measured
+  EXPECT_EQ(convert({{0, {raw}}}, temp / "d", options).header.cellSize, 0.25);
+}
+
+TEST(ConvertSpacing, SpacingThatOverflowsTheGridFallsBackToTheDefaultResolution) {
+  testing::TempDir temp("spacing-fallback");
+  auto points = latticePoints(16, 1e-4f);
+  points.push_back({20, 0, 0});  // 200000 spacings away
+  const fs::path raw = temp / "far.bin";
+  writeRaw(raw, points);
+  const ConvertReport report = convert({{0, {raw}}}, temp / "store", silent());
+  ASSERT_EQ(report.warnings.size(), 1u);
+  EXPECT_NE(report.warnings[0].find("more than 65536"), std::string::npos) << report.warnings[0];
+  EXPECT_NE(report.warnings[0].find("1024 cells"), std::string::npos) << report.warnings[0];
+  EXPECT_DOUBLE_EQ(report.header.cellSize, 20.0 / kDefaultResolution);
+  EXPECT_NEAR(report.header.particleSpacing, 1e-4, 5e-6);  // still recorded
+
+  // Too few particles to measure: the same fallback, the spacing unknown.
+  writeRaw(temp / "few.bin", latticePoints(2, 1.0f));
+  const ConvertReport few = convert({{0, {temp / "few.bin"}}}, temp / "few", silent());
+  ASSERT_EQ(few.warnings.size(), 1u);
+  EXPECT_NE(few.warnings[0].find("unknown"), std::string::npos) << few.warnings[0];
+  EXPECT_EQ(few.header.particleSpacing, 0.0);
+  EXPECT_DOUBLE_EQ(few.header.cellSize, 1.0 / kDefaultResolution);
 }
 
 }  // namespace

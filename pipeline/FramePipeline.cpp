@@ -1,0 +1,176 @@
+#include "pipeline/FramePipeline.h"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include <glm/trigonometric.hpp>
+
+#include "core/Error.h"
+#include "raycast/CpuRaycaster.h"
+#include "raycast/RaycastTypes.h"
+#include "smoothing/CpuScreenDevice.h"
+#include "smoothing/GpuScreenDevice.h"
+#include "smoothing/SurfaceNormals.h"
+#include "smoothing/detail/CpuScreenKernel.h"
+
+namespace flipscope {
+
+namespace glsl {
+struct GBufferKernel : CpuScreenKernel {
+#include "pipeline/glsl/GBuffer.glsl"
+};
+}  // namespace glsl
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+const ScreenPass kSurface{"GBuffer.comp", "gbufferSurface",
+                          cpuScreenPass<glsl::GBufferKernel, &glsl::GBufferKernel::gbufferSurface>};
+const ScreenPass kSphereNormal{"GBuffer.comp", "gbufferSphereNormal",
+                               cpuScreenPass<glsl::GBufferKernel, &glsl::GBufferKernel::gbufferSphereNormal>};
+constexpr std::uint32_t kVec4PerHit = sizeof(RayHit) / sizeof(glm::vec4);
+}  // namespace
+
+EnvironmentMap loadEnvironmentMap(const std::filesystem::path& path) {
+  ExrContents exr = readExr(path);
+  EnvironmentMap map;
+  map.width = exr.image.width;
+  map.height = exr.image.height;
+  map.texels = std::move(exr.image.rgba);
+  for (glm::vec4& t : map.texels) {
+    for (int c = 0; c < 3; ++c)
+      if (!std::isfinite(t[c]) || t[c] < 0) t[c] = 0;
+    t.a = 1;
+  }
+  return map;
+}
+
+/// The images and stage objects, created once the screen device exists.
+struct FramePipeline::Stages {
+  ScreenImage hits = 0;           ///< kVec4PerHit vec4 per pixel
+  ScreenImage gbuffer = 0;        ///< depth, mask, thickness, attribute
+  ScreenImage sphereNormals = 0;
+  ScreenImage smoothed = 0;
+  ScreenImage normals = 0;
+  ScreenImage shaded = 0;
+  std::unique_ptr<SurfaceFilter> filter;
+  std::unique_ptr<SurfaceShading> shading;
+  bool hitsOnDevice = false;      ///< the GPU's hit buffer is adopted, nothing is uploaded
+};
+
+FramePipeline::FramePipeline(BrickStore store, DeviceChoice device, const RenderSettings& settings,
+                             const SurfaceSettings& surface, std::string* fallbackReason)
+    : mSurface(surface) {
+  validate(settings);
+  mSurface.smoothing = resolve(surface.smoothing);
+  const EnvironmentMap map = surface.environment.empty() ? EnvironmentMap{} : loadEnvironmentMap(surface.environment);
+  auto raycaster = createRaycastDevice(device, fallbackReason);
+  auto* gpu = dynamic_cast<GpuRaycaster*>(raycaster.get());
+  const std::string name = raycaster->name();
+  mRenderer = std::make_unique<FrameRenderer>(std::move(store), std::move(raycaster), settings);
+  if (gpu)
+    mScreen = std::make_unique<GpuScreenDevice>(name);
+  else
+    mScreen = std::make_unique<CpuScreenDevice>();
+  ScreenFrame frame{};
+  frame.size = glm::uvec4(settings.width, settings.height, 0, 0);
+  mScreen->setFrame(frame);
+  mStages = std::make_unique<Stages>();
+  Stages& s = *mStages;
+  if (auto* gpuScreen = dynamic_cast<GpuScreenDevice*>(mScreen.get())) {
+    s.hits = gpuScreen->adoptFrameBuffer(&gpu->hitBuffer(), kVec4PerHit);
+    s.hitsOnDevice = true;
+  } else {
+    s.hits = mScreen->createFrameImage(kVec4PerHit);
+  }
+  s.gbuffer = mScreen->createFrameImage();
+  s.sphereNormals = mScreen->createFrameImage();
+  s.smoothed = mScreen->createFrameImage();
+  s.normals = mScreen->createFrameImage();
+  s.shaded = mScreen->createFrameImage();
+  s.filter = createSurfaceFilter(mSurface.smoothing);
+  s.shading = std::make_unique<SurfaceShading>(*mScreen, mSurface.shading, map);
+}
+
+FramePipeline::~FramePipeline() = default;
+
+std::string FramePipeline::deviceName() const { return mScreen->name(); }
+
+ScreenFrame FramePipeline::screenFrame(const Camera& camera) const {
+  const RenderSettings& settings = mRenderer->settings();
+  const StoreHeader& header = mRenderer->store().header();
+  const double tanHalf = std::tan(glm::radians(camera.fovYDegrees) * 0.5);
+  ScreenFrame f{};
+  f.size = glm::uvec4(settings.width, settings.height, 0, 0);
+  f.forward = glm::vec4(glm::vec3(camera.forward()), float(tanHalf));
+  f.right = glm::vec4(glm::vec3(camera.right()), float(settings.width) / float(settings.height));
+  f.up = glm::vec4(glm::vec3(camera.trueUp()), 0.0f);
+  f.worldUp = glm::vec4(glm::vec3(glm::normalize(mSurface.up)), 0.0f);
+  f.focalPixels = float(settings.height / (2.0 * tanHalf));
+  f.particleRadius = float(settings.radius * header.cellSize);
+  f.cellSize = float(header.cellSize);
+  return f;
+}
+
+FrameOutput FramePipeline::render(int frame, const Camera& camera, int direction) {
+  const auto start = Clock::now();
+  FrameOutput out;
+  out.frame = frame;
+  Stages& s = *mStages;
+  ScreenDevice& device = *mScreen;
+
+  auto stage = Clock::now();
+  out.stats = mRenderer->trace(frame, camera, direction);
+  out.stages.trace = msSince(stage);
+
+  auto timed = [&](double& ms, auto&& work) {
+    const auto begin = Clock::now();
+    work();
+    device.finish();
+    ms = msSince(begin);
+  };
+  device.setFrame(screenFrame(camera));
+  timed(out.stages.gbuffer, [&] {
+    if (!s.hitsOnDevice) {
+      const auto& hits = static_cast<const CpuRaycaster&>(mRenderer->device()).hits();
+      device.upload(s.hits, std::span<const glm::vec4>(reinterpret_cast<const glm::vec4*>(hits.data()),
+                                                       hits.size() * kVec4PerHit));
+    }
+    device.run(kSurface, nullptr, 0, {s.hits}, s.gbuffer);
+    device.run(kSphereNormal, nullptr, 0, {s.hits}, s.sphereNormals);
+  });
+  timed(out.stages.smoothing, [&] { s.filter->apply(device, s.gbuffer, s.smoothed); });
+  timed(out.stages.normals, [&] { reconstructNormals(device, s.smoothed, s.normals); });
+  timed(out.stages.shading, [&] { s.shading->shade(device, s.gbuffer, s.normals, s.sphereNormals, s.shaded); });
+
+  timed(out.stages.readback, [&] {
+    RenderImage& image = out.image;
+    image.width = device.width();
+    image.height = device.height();
+    image.rgba = device.download(s.shaded);
+    const auto gbuffer = device.download(s.gbuffer);
+    const auto smoothed = device.download(s.smoothed);
+    const auto normals = device.download(s.normals);
+    const std::size_t n = gbuffer.size();
+    constexpr float kInf = std::numeric_limits<float>::infinity();
+    image.depth.resize(n);
+    image.unsmoothedDepth.resize(n);
+    image.thickness.resize(n);
+    image.normal.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const bool hit = gbuffer[i].y > 0.5f;
+      image.depth[i] = hit ? smoothed[i].x : kInf;
+      image.unsmoothedDepth[i] = hit ? gbuffer[i].x : kInf;
+      image.thickness[i] = hit ? gbuffer[i].z : 0.0f;
+      image.normal[i] = hit ? glm::vec3(normals[i]) : glm::vec3(0);
+    }
+  });
+  out.stages.total = msSince(start);
+  return out;
+}
+
+}  // namespace flipscope

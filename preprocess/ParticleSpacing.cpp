@@ -1,0 +1,361 @@
+// ParticleSpacing: the metadata and neighbour estimates of the particle spacing (see the header).
+#include "preprocess/ParticleSpacing.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numbers>
+#include <random>
+#include <sstream>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <glm/common.hpp>
+#include <glm/vec3.hpp>
+
+#include "core/Error.h"
+
+namespace flipscope {
+namespace {
+
+constexpr std::size_t kChunkParticles = 1 << 16;
+constexpr std::size_t kNeighbours = kSpacingNeighbour;
+
+/// Spacing per k-th neighbour distance r: at spacing r * ballFactor(), a ball of radius r holds k particles.
+double ballFactor() { return std::cbrt(4 * std::numbers::pi / (3 * double(kSpacingNeighbour))); }
+
+bool isFinite(const glm::vec3& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); }
+
+std::string text(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+/// The query particles: a uniform random sample of the source's finite particles.
+struct Sample {
+  std::vector<glm::vec3> positions;
+  std::vector<std::uint64_t> ids;  ///< index of each sampled particle in the source's order
+  std::uint64_t finite = 0;        ///< finite particles in the whole source
+  bool complete() const { return finite == positions.size(); }
+};
+
+/// Reservoir sampling (Vitter's algorithm R), one read of the source, then a rewind.
+Sample reservoirSample(ParticleSource& source, std::size_t size, Progress* progress) {
+  Sample s;
+  std::mt19937_64 rng(0x5041434eull);
+  ParticleChunk chunk;
+  std::uint64_t id = 0;
+  while (source.read(chunk, kChunkParticles)) {
+    for (const glm::vec3& p : chunk.positions) {
+      if (isFinite(p)) {
+        ++s.finite;
+        if (s.positions.size() < size) {
+          s.positions.push_back(p);
+          s.ids.push_back(id);
+        } else if (const std::uint64_t j = std::uniform_int_distribution<std::uint64_t>(0, s.finite - 1)(rng);
+                   j < size) {
+          s.positions[j] = p;
+          s.ids[j] = id;
+        }
+      }
+      ++id;
+    }
+    if (progress) progress->advance(chunk.size());
+  }
+  source.rewind();
+  return s;
+}
+
+/// The k-th neighbour distance of every query among the candidates given to add(), searched as
+/// far as `radius`: a query whose k-th neighbour is farther keeps +inf. Queries are hashed into
+/// cells of 2 * radius, so a candidate only visits the 8 cells on its side of its own cell; a
+/// candidate with the id of a query is that query itself and skipped.
+class KthNeighbours {
+ public:
+  KthNeighbours(const Sample& queries, double radius)
+      : mQueries(queries),
+        mRadius(radius),
+        mCell(2 * radius),
+        mHeaps(queries.positions.size() * kNeighbours, std::numeric_limits<float>::infinity()) {
+    glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
+    for (const glm::vec3& q : queries.positions) {
+      lo = glm::min(lo, glm::dvec3(q));
+      hi = glm::max(hi, glm::dvec3(q));
+    }
+    mOrigin = lo;
+    mLo = lo - radius;
+    mHi = hi + radius;
+    const glm::dvec3 extent = (hi - lo) / mCell;
+    mUsable = queries.positions.size() > 0 && mCell > 0 && std::isfinite(mCell) &&
+              std::max({extent.x, extent.y, extent.z}) < double(1 << 30);
+    if (mUsable) buildTable();
+  }
+
+  /// Candidates with consecutive ids from `firstId` (the source's order).
+  void add(std::span<const glm::vec3> candidates, std::uint64_t firstId) {
+    addAll(candidates.size(), [&](std::size_t i) { return std::pair(candidates[i], firstId + i); });
+  }
+  /// Candidates with the given ids.
+  void add(std::span<const glm::vec3> candidates, std::span<const std::uint64_t> ids) {
+    addAll(candidates.size(), [&](std::size_t i) { return std::pair(candidates[i], ids[i]); });
+  }
+
+  /// The median k-th neighbour distance: exact when more than half the queries found theirs
+  /// within the radius (the others' lie farther), else +inf.
+  double median() const {
+    const std::size_t n = mQueries.positions.size();
+    if (!mUsable || n == 0) return std::numeric_limits<double>::infinity();
+    const double radius2 = mRadius * mRadius;
+    std::vector<double> kth(n);
+    for (std::size_t j = 0; j < n; ++j) {
+      const double d2 = mHeaps[j * kNeighbours];  // the heap's maximum: the k-th smallest
+      kth[j] = d2 <= radius2 ? std::sqrt(d2) : std::numeric_limits<double>::infinity();
+    }
+    auto mid = kth.begin() + std::ptrdiff_t(n / 2);
+    std::nth_element(kth.begin(), mid, kth.end());
+    return *mid;
+  }
+
+ private:
+  struct Slot {
+    glm::ivec3 cell{0};
+    std::uint32_t begin = 0, end = 0;  ///< queries mOrder[begin, end); empty slot when begin == end
+  };
+
+  glm::ivec3 cellOf(const glm::dvec3& p) const { return glm::ivec3(glm::floor((p - mOrigin) / mCell)); }
+
+  static std::uint64_t hash(const glm::ivec3& c) {
+    std::uint64_t h = std::uint64_t(std::uint32_t(c.x)) | (std::uint64_t(std::uint32_t(c.y)) << 32);
+    h ^= std::uint64_t(std::uint32_t(c.z)) * 0x9e3779b97f4a7c15ull;
+    h ^= h >> 31;
+    h *= 0xbf58476d1ce4e5b9ull;
+    h ^= h >> 29;
+    return h;
+  }
+
+  void buildTable() {
+    const std::size_t n = mQueries.positions.size();
+    std::vector<glm::ivec3> cells(n);
+    for (std::size_t j = 0; j < n; ++j) cells[j] = cellOf(glm::dvec3(mQueries.positions[j]));
+    mOrder.resize(n);
+    for (std::size_t j = 0; j < n; ++j) mOrder[j] = std::uint32_t(j);
+    auto less = [](const glm::ivec3& a, const glm::ivec3& b) {
+      return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
+    };
+    std::sort(mOrder.begin(), mOrder.end(), [&](std::uint32_t a, std::uint32_t b) { return less(cells[a], cells[b]); });
+    std::size_t groups = 0;
+    for (std::size_t i = 0; i < n; ++i) groups += i == 0 || cells[mOrder[i]] != cells[mOrder[i - 1]];
+    mTable.assign(std::bit_ceil(std::max<std::size_t>(16, 2 * groups)), Slot{});
+    mMask = mTable.size() - 1;
+    for (std::size_t i = 0; i < n;) {
+      std::size_t end = i + 1;
+      while (end < n && cells[mOrder[end]] == cells[mOrder[i]]) ++end;
+      std::size_t s = hash(cells[mOrder[i]]) & mMask;
+      while (mTable[s].begin != mTable[s].end) s = (s + 1) & mMask;
+      mTable[s] = Slot{cells[mOrder[i]], std::uint32_t(i), std::uint32_t(end)};
+      i = end;
+    }
+  }
+
+  const Slot* find(const glm::ivec3& cell) const {
+    for (std::size_t s = hash(cell) & mMask;; s = (s + 1) & mMask) {
+      const Slot& slot = mTable[s];
+      if (slot.begin == slot.end) return nullptr;
+      if (slot.cell == cell) return &slot;
+    }
+  }
+
+  /// A query's candidate within the radius.
+  struct Hit {
+    std::uint32_t query;
+    float distance2;
+  };
+
+  /// Finds the hits of candidates [0, n) in parallel, then merges them into the heaps.
+  template <class Candidate>
+  void addAll(std::size_t n, Candidate candidate) {
+    if (!mUsable) return;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& range) {
+      std::vector<Hit>& hits = mHits.local();
+      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+        const auto [position, id] = candidate(i);
+        visit(position, id, hits);
+      }
+    });
+    for (std::vector<Hit>& hits : mHits) {
+      for (const Hit& hit : hits) {
+        float* heap = &mHeaps[std::size_t(hit.query) * kNeighbours];
+        if (!(hit.distance2 < heap[0])) continue;
+        std::pop_heap(heap, heap + kNeighbours);
+        heap[kNeighbours - 1] = hit.distance2;
+        std::push_heap(heap, heap + kNeighbours);
+      }
+      hits.clear();
+    }
+  }
+
+  void visit(const glm::vec3& candidate, std::uint64_t id, std::vector<Hit>& hits) const {
+    if (!isFinite(candidate)) return;
+    const glm::dvec3 p(candidate);
+    if (p.x < mLo.x || p.y < mLo.y || p.z < mLo.z || p.x > mHi.x || p.y > mHi.y || p.z > mHi.z) return;
+    const glm::dvec3 f = (p - mOrigin) / mCell;
+    const glm::dvec3 base = glm::floor(f);
+    const glm::ivec3 cell(base);
+    // A query within radius = half a cell lies in this cell or the neighbour on the side of
+    // the half the candidate is in, on every axis.
+    const glm::ivec3 side(f.x - base.x < 0.5 ? -1 : 1, f.y - base.y < 0.5 ? -1 : 1, f.z - base.z < 0.5 ? -1 : 1);
+    const float radius2 = float(mRadius * mRadius);
+    for (int corner = 0; corner < 8; ++corner) {
+      const glm::ivec3 c = cell + glm::ivec3(corner & 1 ? side.x : 0, corner & 2 ? side.y : 0, corner & 4 ? side.z : 0);
+      const Slot* slot = find(c);
+      if (!slot) continue;
+      for (std::uint32_t i = slot->begin; i < slot->end; ++i) {
+        const std::uint32_t j = mOrder[i];
+        if (mQueries.ids[j] == id) continue;
+        const glm::vec3 d = mQueries.positions[j] - candidate;
+        const float d2 = d.x * d.x + d.y * d.y + d.z * d.z;
+        if (d2 <= radius2) hits.push_back({j, d2});
+      }
+    }
+  }
+
+  const Sample& mQueries;
+  double mRadius, mCell;
+  glm::dvec3 mOrigin{0}, mLo{0}, mHi{0};
+  bool mUsable = false;
+  std::vector<std::uint32_t> mOrder;
+  std::vector<Slot> mTable;
+  std::size_t mMask = 0;
+  std::vector<float> mHeaps;  ///< k squared distances per query, a max-heap each
+  tbb::enumerable_thread_specific<std::vector<Hit>> mHits;
+};
+
+/// The median k-th neighbour distance among the sample itself (exact: the radius doubles from
+/// a small start until more than half the queries have their k-th neighbour within it).
+double medianWithinSample(const Sample& s) {
+  const std::size_t n = s.positions.size();
+  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
+  for (const glm::vec3& p : s.positions) {
+    lo = glm::min(lo, glm::dvec3(p));
+    hi = glm::max(hi, glm::dvec3(p));
+  }
+  const glm::dvec3 extent = hi - lo;
+  const double longest = std::max({extent.x, extent.y, extent.z});
+  if (!(longest > 0)) return 0;  // every particle at one point
+  // Start from the spacing of the central 98 % of the particles spread over their box / 16:
+  // each failed try is cheap, a radius far too large is not.
+  double volume = 1;
+  std::vector<float> axis(n);
+  for (int a = 0; a < 3; ++a) {
+    for (std::size_t i = 0; i < n; ++i) axis[i] = s.positions[i][a];
+    auto low = axis.begin() + std::ptrdiff_t(n / 100), high = axis.begin() + std::ptrdiff_t(n - 1 - n / 100);
+    std::nth_element(axis.begin(), low, axis.end());
+    const float q0 = *low;
+    std::nth_element(axis.begin(), high, axis.end());
+    volume *= std::max(double(*high) - double(q0), 1e-3 * longest);
+  }
+  double radius = std::cbrt(volume / double(n)) / 16;
+  // Beyond 2 * longest every query has every other particle (n > k) within the radius.
+  for (int attempt = 0; attempt < 64; ++attempt, radius *= 2) {
+    KthNeighbours search(s, std::min(radius, 2 * longest));
+    search.add(s.positions, s.ids);
+    const double median = search.median();
+    if (std::isfinite(median)) return median;
+    if (radius >= 2 * longest) break;
+  }
+  return std::numeric_limits<double>::infinity();
+}
+
+/// A ParticleSource over points in memory.
+class SpanSource final : public ParticleSource {
+ public:
+  explicit SpanSource(std::span<const glm::vec3> points) : mPoints(points) {}
+  std::string name() const override { return "points in memory"; }
+  bool hasVelocity() const override { return false; }
+  std::optional<std::uint64_t> countHint() const override { return mPoints.size(); }
+  bool read(ParticleChunk& chunk, std::size_t maxParticles) override {
+    chunk.clear();
+    const std::size_t n = std::min(maxParticles, mPoints.size() - mNext);
+    chunk.positions.assign(mPoints.begin() + std::ptrdiff_t(mNext), mPoints.begin() + std::ptrdiff_t(mNext + n));
+    mNext += n;
+    return n > 0;
+  }
+  void rewind() override { mNext = 0; }
+
+ private:
+  std::span<const glm::vec3> mPoints;
+  std::size_t mNext = 0;
+};
+
+}  // namespace
+
+SpacingEstimate hintSpacing(const SpacingHint& hint) {
+  SpacingEstimate e;
+  if (hint.points == 0) return e;
+  const double spacing = std::cbrt(hint.volume / double(hint.points));
+  if (!(std::isfinite(spacing) && spacing > 0)) return e;
+  e.spacing = spacing;
+  e.origin = hint.origin;
+  return e;
+}
+
+SpacingEstimate neighbourSpacing(ParticleSource& source, std::size_t sampleSize, Progress* progress) {
+  sampleSize = std::max(sampleSize, kNeighbours + 1);
+  const Sample sample = reservoirSample(source, sampleSize, progress);
+  SpacingEstimate e;
+  if (sample.finite < kNeighbours + 1) {
+    e.origin = "too few particles to measure (" + std::to_string(sample.finite) + " finite)";
+    return e;
+  }
+  double median = medianWithinSample(sample);
+  std::string of = "all " + std::to_string(sample.finite) + " particles";
+  if (!sample.complete() && std::isfinite(median) && median > 0) {
+    // The sample is a random thinning to density n / N: distances shrink by cbrt(n / N).
+    of = std::to_string(sample.positions.size()) + " sampled of " + std::to_string(sample.finite) + " particles";
+    double radius = 1.5 * median * std::cbrt(double(sample.positions.size()) / double(sample.finite));
+    median = std::numeric_limits<double>::infinity();
+    for (int pass = 1; pass < kSpacingMaxPasses && !std::isfinite(median); ++pass, radius *= 2) {
+      KthNeighbours search(sample, radius);
+      ParticleChunk chunk;
+      std::uint64_t id = 0;
+      while (source.read(chunk, kChunkParticles)) {
+        search.add(chunk.positions, id);
+        id += chunk.size();
+        if (progress) progress->advance(chunk.size());
+      }
+      source.rewind();
+      median = search.median();
+    }
+  }
+  if (!std::isfinite(median)) {
+    e.origin = "neighbour distances of " + of + " not found within " + std::to_string(kSpacingMaxPasses) + " reads";
+    return e;
+  }
+  if (!(median > 0)) {
+    e.origin = "most of " + of + " coincide with " + std::to_string(kSpacingNeighbour) + " others";
+    return e;
+  }
+  e.spacing = median * ballFactor();
+  e.origin = "median " + std::to_string(kSpacingNeighbour) + "th-neighbour distance " + text(median) + " of " + of;
+  return e;
+}
+
+SpacingEstimate neighbourSpacing(std::span<const glm::vec3> points, std::size_t sampleSize) {
+  SpanSource source(points);
+  return neighbourSpacing(source, sampleSize);
+}
+
+SpacingEstimate estimateParticleSpacing(ParticleSource& source, Progress* progress) {
+  if (auto hint = source.spacingHint()) {
+    SpacingEstimate e = hintSpacing(*hint);
+    if (e.known()) return e;
+  }
+  return neighbourSpacing(source, kSpacingSample, progress);
+}
+
+}  // namespace flipscope

@@ -1,0 +1,148 @@
+// The particle spacing estimates (ParticleSpacing.h): the neighbour estimate on point sets of
+// known spacing, in memory and streamed (sampled), and on the Mantaflow sample against the
+// OpenVDB metadata estimate of the same points.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <random>
+
+#include <glm/common.hpp>
+
+#include "VectorSource.h"
+#include "preprocess/ParticleSpacing.h"
+
+namespace flipscope {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// n^3 particles on a cubic lattice of `spacing` from `origin`, each moved by up to
+/// jitter * spacing / 2 along every axis (uniform), shuffled (a file order without locality).
+std::vector<glm::vec3> lattice(int n, float spacing, float jitter, glm::vec3 origin = {-1.3f, 0.7f, 2.1f},
+                               unsigned seed = 5) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-0.5f, 0.5f);
+  std::vector<glm::vec3> points;
+  for (int x = 0; x < n; ++x)
+    for (int y = 0; y < n; ++y)
+      for (int z = 0; z < n; ++z)
+        points.push_back(origin + spacing * glm::vec3(x + jitter * u(rng), y + jitter * u(rng), z + jitter * u(rng)));
+  std::shuffle(points.begin(), points.end(), rng);
+  return points;
+}
+
+fs::path mantaflowFrame(const char* folder, const char* name) {
+  return fs::path(FLIPSCOPE_DATA_DIR) / "mantaflow-dam64" / folder / name;
+}
+
+TEST(ParticleSpacing, RegularLatticeGivesItsSpacing) {
+  for (float spacing : {0.1f, 2.5f}) {
+    const auto points = lattice(24, spacing, 0);  // 13824 particles: every one a query
+    const SpacingEstimate e = neighbourSpacing(points);
+    ASSERT_TRUE(e.known()) << e.origin;
+    EXPECT_NEAR(e.spacing, spacing, 0.03 * spacing) << e.origin;
+    EXPECT_NE(e.origin.find("all 13824 particles"), std::string::npos) << e.origin;
+  }
+}
+
+TEST(ParticleSpacing, JitteredAndRandomPointsGiveTheirSpacing) {
+  // One particle per cell anywhere in it (jitter 1), half-cell jitter, and uniform random points
+  // at the same density: the volume per particle is spacing^3 in every case.
+  for (float jitter : {0.5f, 1.0f}) {
+    const SpacingEstimate e = neighbourSpacing(lattice(26, 0.04f, jitter));
+    ASSERT_TRUE(e.known()) << e.origin;
+    EXPECT_NEAR(e.spacing, 0.04, 0.05 * 0.04) << "jitter " << jitter << ": " << e.origin;
+  }
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0, 30 * 0.2f);
+  std::vector<glm::vec3> random(30 * 30 * 30);
+  for (auto& p : random) p = {u(rng), u(rng), u(rng)};
+  const SpacingEstimate e = neighbourSpacing(random);
+  ASSERT_TRUE(e.known()) << e.origin;
+  EXPECT_NEAR(e.spacing, 0.2, 0.05 * 0.2) << e.origin;
+}
+
+TEST(ParticleSpacing, SampledEstimateReadsEveryParticleForNeighbours) {
+  // 40^3 particles, 2000 sampled: neighbours among the sample alone would be 3 times farther.
+  const auto points = lattice(40, 0.5f, 0.5f);
+  testing::VectorSource source(points);
+  const SpacingEstimate e = neighbourSpacing(source, 2000);
+  ASSERT_TRUE(e.known()) << e.origin;
+  EXPECT_NEAR(e.spacing, 0.5, 0.05 * 0.5) << e.origin;
+  EXPECT_NE(e.origin.find("2000 sampled of 64000 particles"), std::string::npos) << e.origin;
+  // Deterministic, and the source is rewound.
+  EXPECT_EQ(neighbourSpacing(source, 2000).spacing, e.spacing);
+  ParticleChunk chunk;
+  ASSERT_TRUE(source.read(chunk, 1));
+  EXPECT_EQ(chunk.positions[0], points[0]);
+}
+
+TEST(ParticleSpacing, NonFiniteSkippedAndDegenerateInputsUnknown) {
+  auto points = lattice(20, 1.0f, 0);
+  for (std::size_t i = 0; i < points.size(); i += 7) {
+    const float bad = i % 2 ? std::numeric_limits<float>::quiet_NaN() : std::numeric_limits<float>::infinity();
+    points.insert(points.begin() + std::ptrdiff_t(i), glm::vec3(1, bad, 1));
+  }
+  EXPECT_NEAR(neighbourSpacing(points).spacing, 1.0, 0.03);
+  EXPECT_NEAR(neighbourSpacing(points, 1000).spacing, 1.0, 0.05);  // sampled: ids count the skipped ones
+
+  EXPECT_FALSE(neighbourSpacing(std::vector<glm::vec3>{}).known());
+  const SpacingEstimate few = neighbourSpacing(lattice(2, 1.0f, 0));  // 8 particles < k + 1
+  EXPECT_FALSE(few.known());
+  EXPECT_NE(few.origin.find("too few"), std::string::npos) << few.origin;
+  EXPECT_FALSE(neighbourSpacing(std::vector<glm::vec3>(500, glm::vec3(1, 2, 3))).known());  // all coincide
+}
+
+TEST(ParticleSpacing, HintsGiveTheVolumePerParticle) {
+  SpacingHint hint{8.0, 1000, "test"};
+  EXPECT_DOUBLE_EQ(hintSpacing(hint).spacing, 0.2);
+  EXPECT_FALSE(hintSpacing(SpacingHint{1.0, 0, "none"}).known());
+  EXPECT_FALSE(hintSpacing(SpacingHint{std::numeric_limits<double>::infinity(), 5, "bad"}).known());
+  // Sources without metadata are measured.
+  testing::VectorSource source(lattice(16, 0.3f, 0));
+  EXPECT_FALSE(source.spacingHint());
+  EXPECT_NEAR(estimateParticleSpacing(source).spacing, 0.3, 0.03 * 0.3);
+}
+
+TEST(ParticleSpacing, MantaflowVdbMetadataAgreesWithNeighbours) {
+  const fs::path path = mantaflowFrame("data", "fluid_data_0030.vdb");
+  ASSERT_TRUE(fs::exists(path)) << path;
+  auto source = openParticleFile(path);
+  const auto hint = source->spacingHint();
+  ASSERT_TRUE(hint);
+  EXPECT_EQ(hint->points, source->countHint());
+  EXPECT_NE(hint->origin.find("'particles'"), std::string::npos) << hint->origin;
+  const SpacingEstimate vdb = estimateParticleSpacing(*source);
+  ASSERT_TRUE(vdb.known());
+  // Blender's 64-cell dam break: voxels of 0.0625, about 8 particles a cell where it is full.
+  EXPECT_GT(vdb.spacing, 0.0625 / 2 * 0.9);
+  EXPECT_LT(vdb.spacing, 0.0625);
+  const SpacingEstimate nn = neighbourSpacing(*source);
+  ASSERT_TRUE(nn.known()) << nn.origin;
+  EXPECT_NEAR(nn.spacing, vdb.spacing, 0.3 * vdb.spacing) << "VDB " << vdb.origin << "; neighbours " << nn.origin;
+  std::printf("fluid_data_0030.vdb: VDB estimate %g (%s), neighbour estimate %g (%s)\n", vdb.spacing,
+              vdb.origin.c_str(), nn.spacing, nn.origin.c_str());
+
+  // FLIP and secondary particles read as one frame: the hints add up.
+  std::vector<std::unique_ptr<ParticleSource>> parts;
+  parts.push_back(openParticleFile(path));
+  parts.push_back(openParticleFile(mantaflowFrame("particles", "fluid_particles_0030.vdb")));
+  const auto secondary = parts.back()->spacingHint();
+  ASSERT_TRUE(secondary);
+  auto both = concatSources(std::move(parts));
+  const auto sum = both->spacingHint();
+  ASSERT_TRUE(sum);
+  EXPECT_EQ(sum->points, hint->points + secondary->points);
+  EXPECT_DOUBLE_EQ(sum->volume, hint->volume + secondary->volume);
+  // A part without metadata leaves the whole to the neighbour estimate.
+  std::vector<std::unique_ptr<ParticleSource>> mixed;
+  mixed.push_back(openParticleFile(path));
+  mixed.push_back(std::make_unique<testing::VectorSource>(lattice(3, 1.0f, 0)));
+  EXPECT_FALSE(concatSources(std::move(mixed))->spacingHint());
+}
+
+}  // namespace
+}  // namespace flipscope
