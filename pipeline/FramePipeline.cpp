@@ -32,6 +32,8 @@ const ScreenPass kSurface{"GBuffer.comp", "gbufferSurface",
                           cpuScreenPass<glsl::GBufferKernel, &glsl::GBufferKernel::gbufferSurface>};
 const ScreenPass kSphereNormal{"GBuffer.comp", "gbufferSphereNormal",
                                cpuScreenPass<glsl::GBufferKernel, &glsl::GBufferKernel::gbufferSphereNormal>};
+const ScreenPass kBlurThickness{"GBuffer.comp", "gbufferBlurThickness",
+                                cpuScreenPass<glsl::GBufferKernel, &glsl::GBufferKernel::gbufferBlurThickness>};
 constexpr std::uint32_t kVec4PerHit = sizeof(RayHit) / sizeof(glm::vec4);
 }  // namespace
 
@@ -52,7 +54,8 @@ EnvironmentMap loadEnvironmentMap(const std::filesystem::path& path) {
 /// The images and stage objects, created once the screen device exists.
 struct FramePipeline::Stages {
   ScreenImage hits = 0;           ///< kVec4PerHit vec4 per pixel
-  ScreenImage gbuffer = 0;        ///< depth, mask, thickness, attribute
+  ScreenImage rawGbuffer = 0;     ///< depth, mask, thickness, attribute
+  ScreenImage gbuffer = 0;        ///< the same with the thickness blurred
   ScreenImage sphereNormals = 0;
   ScreenImage smoothed = 0;
   ScreenImage normals = 0;
@@ -87,6 +90,7 @@ FramePipeline::FramePipeline(BrickStore store, DeviceChoice device, const Render
   } else {
     s.hits = mScreen->createFrameImage(kVec4PerHit);
   }
+  s.rawGbuffer = mScreen->createFrameImage();
   s.gbuffer = mScreen->createFrameImage();
   s.sphereNormals = mScreen->createFrameImage();
   s.smoothed = mScreen->createFrameImage();
@@ -140,7 +144,8 @@ FrameOutput FramePipeline::render(int frame, const Camera& camera, int direction
       device.upload(s.hits, std::span<const glm::vec4>(reinterpret_cast<const glm::vec4*>(hits.data()),
                                                        hits.size() * kVec4PerHit));
     }
-    device.run(kSurface, nullptr, 0, {s.hits}, s.gbuffer);
+    device.run(kSurface, nullptr, 0, {s.hits}, s.rawGbuffer);
+    device.run(kBlurThickness, nullptr, 0, {s.rawGbuffer}, s.gbuffer);
     device.run(kSphereNormal, nullptr, 0, {s.hits}, s.sphereNormals);
   });
   timed(out.stages.smoothing, [&] { s.filter->apply(device, s.gbuffer, s.smoothed); });

@@ -29,7 +29,8 @@ ShadingMode parseShadingMode(const std::string& text) {
   if (text == "liquid") return ShadingMode::Liquid;
   if (text == "spheres") return ShadingMode::Spheres;
   if (text == "attribute") return ShadingMode::Attribute;
-  throw InputError("--shading: unknown mode '" + text + "'; valid values: liquid, spheres, attribute");
+  if (text == "normals") return ShadingMode::Normals;
+  throw InputError("--shading: unknown mode '" + text + "'; valid values: liquid, spheres, attribute, normals");
 }
 
 SurfaceShading::SurfaceShading(ScreenDevice& device, const ShadingOptions& options, const EnvironmentMap& map)
@@ -51,9 +52,12 @@ void SurfaceShading::shade(ScreenDevice& device, ScreenImage gbuffer, ScreenImag
   p.liquidColour = glm::vec4(mOptions.liquidColour, 0);
   p.slowColour = glm::vec4(mOptions.slowColour, 0);
   p.fastColour = glm::vec4(mOptions.fastColour, 0);
-  p.mode = mOptions.mode == ShadingMode::Liquid ? glsl::kShadeLiquid
-           : mOptions.mode == ShadingMode::Spheres ? glsl::kShadeSpheres
-                                                   : glsl::kShadeAttribute;
+  switch (mOptions.mode) {
+    case ShadingMode::Liquid: p.mode = glsl::kShadeLiquid; break;
+    case ShadingMode::Spheres: p.mode = glsl::kShadeSpheres; break;
+    case ShadingMode::Attribute: p.mode = glsl::kShadeAttribute; break;
+    case ShadingMode::Normals: p.mode = glsl::kShadeNormals; break;
+  }
   p.environmentWidth = mMapWidth;
   p.environmentHeight = mMapHeight;
   p.fresnelF0 = mOptions.fresnelF0;

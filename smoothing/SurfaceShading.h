@@ -12,8 +12,9 @@
 
 namespace flipscope {
 
-enum class ShadingMode { Liquid, Spheres, Attribute };
-/// "liquid", "spheres" or "attribute". Throws InputError naming --shading and the valid values.
+enum class ShadingMode { Liquid, Spheres, Attribute, Normals };
+/// "liquid", "spheres", "attribute" or "normals". Throws InputError naming --shading and the
+/// valid values.
 ShadingMode parseShadingMode(const std::string& text);
 
 /// An equirectangular environment map, linear RGB, row 0 at the top (the up direction).
@@ -25,13 +26,13 @@ struct EnvironmentMap {
 struct ShadingOptions {
   ShadingMode mode = ShadingMode::Liquid;
   glm::vec3 lightFromCamera{-0.45f, 0.75f, 0.50f};  ///< towards the sun: camera right, up, backwards
-  glm::vec3 absorption{0.075f, 0.030f, 0.016f};      ///< Beer-Lambert per cell of liquid (RGB)
-  glm::vec3 liquidColour{0.02f, 0.16f, 0.24f};       ///< light scattered in deep liquid
+  glm::vec3 absorption{0.30f, 0.11f, 0.06f};         ///< Beer-Lambert per cell of liquid (RGB)
+  glm::vec3 liquidColour{0.03f, 0.17f, 0.28f};       ///< light scattered in deep liquid
   glm::vec3 slowColour{0.05f, 0.26f, 0.55f};         ///< attribute 0
   glm::vec3 fastColour{0.80f, 0.92f, 1.00f};         ///< attribute 1 (fastest of the frame)
   float fresnelF0 = 0.02f;                            ///< water
   float refraction = 12.0f;                           ///< pixels of background offset per unit tilt
-  float specular = 0.6f;
+  float specular = 0.45f;
   float shininess = 120.0f;
 };
 

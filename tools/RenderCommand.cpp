@@ -119,7 +119,7 @@ void addRenderCommand(CLI::App& app) {
                   "Filter iterations (default: the filter's; see README, Smoothing)");
   cmd->add_option("--smoothing-strength", args->smoothingStrength,
                   "Filter strength: lambda0 in particle radii for rof, the filter's size for the others");
-  cmd->add_option("--shading", args->shading, "liquid, spheres (lit spheres) or attribute (colour by attribute)")
+  cmd->add_option("--shading", args->shading, "liquid, spheres (lit spheres), attribute (colour by attribute) or normals")
       ->capture_default_str();
   cmd->add_option("--env", args->environment, "Equirectangular EXR environment (default: procedural sky and ground)");
   cmd->add_option("--jitter", args->jitter, "Per-cell jitter: on (0.25 cells), off, or cells")->capture_default_str();

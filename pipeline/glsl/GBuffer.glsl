@@ -22,3 +22,26 @@ FS_FUNC vec4 gbufferSphereNormal(ivec2 p) {
   if (floatBitsToUint(ray.y) != kRayHit) return vec4(0.0f);
   return vec4(normal.x, normal.y, normal.z, 1.0f);
 }
+
+// gbufferBlurThickness (input 0: the gbufferSurface image) -> the same with its thickness
+// averaged over the foreground pixels within one particle's screen radius (at most 8 pixels) that
+// lie on the same surface (depth within 4 particle radii): the thickness of one ray counts the
+// set cells it meets, which varies from pixel to pixel more than the liquid does.
+FS_FUNC vec4 gbufferBlurThickness(ivec2 p) {
+  vec4 here = ssLoad(0u, p);
+  if (here.y < 0.5f) return here;
+  int radius = int(clamp(F.focalPixels * F.particleRadius / max(here.x, 1.0e-6f), 1.0f, 8.0f));
+  float sum = 0.0f;
+  float count = 0.0f;
+  for (int dy = -radius; dy <= radius; dy++) {
+    for (int dx = -radius; dx <= radius; dx++) {
+      ivec2 q = p + ivec2(dx, dy);
+      if (!ssInside(q)) continue;
+      vec4 n = ssLoad(0u, q);
+      if (n.y < 0.5f || abs(n.x - here.x) > 4.0f * F.particleRadius) continue;
+      sum += n.z;
+      count += 1.0f;
+    }
+  }
+  return vec4(here.x, here.y, sum / count, here.w);
+}

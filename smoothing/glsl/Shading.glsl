@@ -75,6 +75,8 @@ FS_FUNC vec4 shadeSurface(ivec2 p) {
     vec3 n = vec3(nn.x, nn.y, nn.z);
     if (S.mode == kShadeAttribute) {
       colour = shLit(shAttributeColour(g.w), n, view);
+    } else if (S.mode == kShadeNormals) {
+      colour = n * 0.5f + vec3(0.5f);
     } else {
       // §3.6: the background behind the liquid, offset along the normal's screen-space tilt.
       vec3 right = vec3(F.right.x, F.right.y, F.right.z);

@@ -3,6 +3,7 @@
 const uint kShadeLiquid = 0u;     // Fresnel reflection, refracted background, absorption (§3.6)
 const uint kShadeSpheres = 1u;    // the ray-caster's sphere normals, Lambert and Blinn
 const uint kShadeAttribute = 2u;  // colour by the stored attribute on the smoothed surface
+const uint kShadeNormals = 3u;    // the smoothed world normal as colour, n * 0.5 + 0.5
 
 struct ShadingParams {
   vec4 lightDirection;   // xyz: unit world direction towards the sun; w: sun intensity
@@ -10,7 +11,7 @@ struct ShadingParams {
   vec4 liquidColour;     // xyz: colour of light scattered in the liquid; w: unused
   vec4 slowColour;       // xyz: attribute 0 (spheres, attribute modes); w: unused
   vec4 fastColour;       // xyz: attribute 1; w: unused
-  uint mode;             // kShadeLiquid, kShadeSpheres or kShadeAttribute
+  uint mode;             // kShadeLiquid, kShadeSpheres, kShadeAttribute or kShadeNormals
   uint environmentWidth;   // equirectangular map (input 3), 0: the procedural sky and ground
   uint environmentHeight;
   uint unused0;

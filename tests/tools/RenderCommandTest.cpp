@@ -115,7 +115,7 @@ TEST_F(Render, BadInputsGiveClearErrors) {
   expectError(path("store") + " -o " + path("x.png") + " --smoothing rof --smoothing-strength 1e9",
               "valid values: 0..");
   expectError(path("store") + " -o " + path("x.png") + " --shading glass",
-              "valid values: liquid, spheres, attribute");
+              "valid values: liquid, spheres, attribute, normals");
   expectError(path("store") + " -o " + path("x.png") + " --env " + path("missing.exr"), "missing.exr", 3);
   EXPECT_FALSE(fs::exists(path("x.png")));
 
