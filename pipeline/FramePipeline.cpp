@@ -67,6 +67,10 @@ struct FramePipeline::Stages {
 
 FramePipeline::FramePipeline(BrickStore store, DeviceChoice device, const RenderSettings& settings,
                              const SurfaceSettings& surface, std::string* fallbackReason)
+    : FramePipeline(std::make_shared<StoreBrickSource>(std::move(store)), device, settings, surface, fallbackReason) {}
+
+FramePipeline::FramePipeline(std::shared_ptr<BrickSource> source, DeviceChoice device, const RenderSettings& settings,
+                             const SurfaceSettings& surface, std::string* fallbackReason)
     : mSurface(surface) {
   validate(settings);
   mSurface.smoothing = resolve(surface.smoothing);
@@ -74,7 +78,7 @@ FramePipeline::FramePipeline(BrickStore store, DeviceChoice device, const Render
   auto raycaster = createRaycastDevice(device, fallbackReason);
   auto* gpu = dynamic_cast<GpuRaycaster*>(raycaster.get());
   const std::string name = raycaster->name();
-  mRenderer = std::make_unique<FrameRenderer>(std::move(store), std::move(raycaster), settings);
+  mRenderer = std::make_unique<FrameRenderer>(std::move(source), std::move(raycaster), settings);
   if (gpu)
     mScreen = std::make_unique<GpuScreenDevice>(name);
   else
@@ -106,7 +110,7 @@ std::string FramePipeline::deviceName() const { return mScreen->name(); }
 
 ScreenFrame FramePipeline::screenFrame(const Camera& camera) const {
   const RenderSettings& settings = mRenderer->settings();
-  const StoreHeader& header = mRenderer->store().header();
+  const StoreHeader& header = mRenderer->source().header();
   const double tanHalf = std::tan(glm::radians(camera.fovYDegrees) * 0.5);
   ScreenFrame f{};
   f.size = glm::uvec4(settings.width, settings.height, 0, 0);

@@ -4,9 +4,12 @@
 // normals); the surface filter smooths the depth (smoothing/SurfaceFilter.h, §3.4); normals are
 // reconstructed from the smoothed depth and the surface is shaded (§3.6). On a GPU every stage
 // is a compute pass in the ray-caster's context; on the CPU every stage is its C++ reference.
-// `render`, `demo`, `bench` and the viewer all render through it.
+// `render`, `demo`, `bench` and the viewer all render through it. Bricks come from any
+// BrickSource (streaming/BrickSource.h): a store, or a synthetic source in tests.
 //
 //   FramePipeline pipeline(BrickStore::open(dir), DeviceChoice::Auto, RenderSettings{}, SurfaceSettings{});
+//   FramePipeline synthetic(std::make_shared<SyntheticBrickSource>(32, glm::uvec3(4, 4, 2), 1, 0.3),
+//                           DeviceChoice::Cpu, RenderSettings{}, SurfaceSettings{});
 //   FrameOutput out = pipeline.render(frame, camera);
 //   writeImage("a.exr", out.image);
 //
@@ -58,9 +61,12 @@ struct FrameOutput {
 
 class FramePipeline {
  public:
-  /// Throws InputError for bad settings, FileError for an unreadable environment map, and
-  /// gl::Unavailable when `device` is Gpu and there is none. `fallbackReason` says why Auto
-  /// chose the CPU.
+  /// Renders the bricks of `source`, shared with the ray-caster's Streamer. Throws InputError
+  /// for bad settings, FileError for an unreadable environment map, and gl::Unavailable when
+  /// `device` is Gpu and there is none. `fallbackReason` says why Auto chose the CPU.
+  FramePipeline(std::shared_ptr<BrickSource> source, DeviceChoice device, const RenderSettings& settings,
+                const SurfaceSettings& surface, std::string* fallbackReason = nullptr);
+  /// The same over a store (through a StoreBrickSource).
   FramePipeline(BrickStore store, DeviceChoice device, const RenderSettings& settings,
                 const SurfaceSettings& surface, std::string* fallbackReason = nullptr);
   ~FramePipeline();

@@ -28,7 +28,7 @@ std::uint32_t sphereReach(float radius, float jitter) {
 
 float defaultSphereRadius(const StoreHeader& header, float jitter) {
   if (!(header.particleSpacing > 0) || !(header.cellSize > 0)) return 1.0f;
-  float radius = std::max(1.0f, float(header.particleSpacing / header.cellSize));
+  float radius = std::max(1.0f, float(kDefaultRadiusPerSpacing * header.particleSpacing / header.cellSize));
   // The largest radius whose reach fits the border: reach = ceil(radius + jitter + 0.5) - 1.
   const float largest = float(kMaxOverlap) + 0.5f - jitter;
   return std::min(radius, std::max(largest, 0.5f));
@@ -49,12 +49,12 @@ void validate(const RenderSettings& s) {
 }
 
 namespace {
-StreamerOptions streamerOptions(const BrickStore& store, const RenderSettings& settings, std::uint32_t reach) {
+StreamerOptions streamerOptions(const StoreHeader& header, const RenderSettings& settings, std::uint32_t reach) {
   StreamerOptions options;
-  options.conversion.brickSize = store.header().brickSize;
+  options.conversion.brickSize = header.brickSize;
   options.conversion.overlap = reach;
   options.conversion.attribute =
-      store.header().attribute == AttributeKind::None ? AttributeReduction::None : AttributeReduction::Max;
+      header.attribute == AttributeKind::None ? AttributeReduction::None : AttributeReduction::Max;
   options.mipDilation = reach;
   options.threads = settings.threads ? settings.threads : std::max(1u, std::thread::hardware_concurrency());
   options.cacheBytes = settings.cpuCacheBytes;
@@ -63,13 +63,13 @@ StreamerOptions streamerOptions(const BrickStore& store, const RenderSettings& s
 }
 
 /// The pool within the budget, shrunk until its largest buffer (the bits) fits the device.
-PoolLayout poolLayout(const BrickStore& store, const RenderSettings& settings, std::uint32_t reach,
+PoolLayout poolLayout(const StoreHeader& header, const RenderSettings& settings, std::uint32_t reach,
                       std::uint64_t maxBufferBytes) {
   validate(settings);
-  const bool attributes = store.header().attribute != AttributeKind::None;
+  const bool attributes = header.attribute != AttributeKind::None;
   std::uint64_t budget = settings.gpuBudgetBytes;
   for (;;) {
-    PoolLayout layout = PoolLayout::forBudget(store.header().brickSize, reach, attributes, budget);
+    PoolLayout layout = PoolLayout::forBudget(header.brickSize, reach, attributes, budget);
     const std::uint64_t bits = std::uint64_t(layout.slots) * layout.subBricksPerSlot * 16;
     const std::uint64_t ring = layout.attributeCapacity * 2;
     if (bits <= maxBufferBytes && ring <= maxBufferBytes) return layout;
@@ -78,25 +78,32 @@ PoolLayout poolLayout(const BrickStore& store, const RenderSettings& settings, s
 }
 }  // namespace
 
-FrameRenderer::FrameRenderer(BrickStore store, std::unique_ptr<RaycastDevice> device, const RenderSettings& settings)
-    : mStore(std::move(store)),
+namespace {
+std::shared_ptr<BrickSource> checked(std::shared_ptr<BrickSource> source) {
+  FLIPSCOPE_CHECK(source, "FrameRenderer without a brick source");
+  return source;
+}
+}  // namespace
+
+FrameRenderer::FrameRenderer(std::shared_ptr<BrickSource> source, std::unique_ptr<RaycastDevice> device,
+                             const RenderSettings& settings)
+    : mSource(checked(std::move(source))),
       mDevice(std::move(device)),
       mSettings(settings),
       mReach(sphereReach(settings.radius, settings.jitter)),
-      mPool(poolLayout(mStore, settings, mReach, mDevice->maxBufferBytes())) {
+      mPool(poolLayout(mSource->header(), settings, mReach, mDevice->maxBufferBytes())) {
   mDevice->allocatePool(mPool.layout());
-  mStreamer =
-      std::make_unique<Streamer>(std::make_shared<StoreBrickSource>(mStore), streamerOptions(mStore, settings, mReach));
+  mStreamer = std::make_unique<Streamer>(mSource, streamerOptions(mSource->header(), settings, mReach));
 }
 
 FrameRenderer::~FrameRenderer() = default;
 
 Box FrameRenderer::occupiedBounds(int first, int last) const {
-  const StoreHeader& h = mStore.header();
+  const StoreHeader& h = mSource->header();
   std::vector<std::shared_ptr<const FrameIndex>> frames;
   glm::uvec3 lo(~0u), hi(0u);
   for (int f = first; f <= last; ++f) {
-    frames.push_back(mStore.frame(f));
+    frames.push_back(mSource->frame(f));
     for (const BrickRecord& record : frames.back()->bricks) {
       lo = glm::min(lo, record.coord);
       hi = glm::max(hi, record.coord);
@@ -117,9 +124,10 @@ Box FrameRenderer::occupiedBounds(int first, int last) const {
   if (outer.size() > kMaxDecoded) return Box{h.origin + lower * h.cellSize, h.origin + upper * h.cellSize};
   glm::dvec3 cellMin(std::numeric_limits<double>::infinity()), cellMax(-std::numeric_limits<double>::infinity());
   for (const auto& [index, i] : outer) {
-    const DecodedBrick brick = mStore.readBrick(*index, i);
+    const auto brick = mSource->read(BrickKey{index->frame, index->bricks[i].coord});
+    FLIPSCOPE_CHECK(brick, "brick " << i << " of frame " << index->frame << " listed but empty");
     const glm::dvec3 base(index->bricks[i].coord * h.brickSize);
-    for (std::uint32_t cell : brick.cells) {
+    for (std::uint32_t cell : brick->cells) {
       const glm::dvec3 c =
           base + glm::dvec3(cell % h.brickSize, cell / h.brickSize % h.brickSize, cell / (h.brickSize * h.brickSize));
       cellMin = glm::min(cellMin, c);
@@ -130,7 +138,7 @@ Box FrameRenderer::occupiedBounds(int first, int last) const {
 }
 
 RaycastParams FrameRenderer::params(const Camera& camera, const FrameIndex& frame) const {
-  const StoreHeader& h = mStore.header();
+  const StoreHeader& h = mSource->header();
   const PoolLayout& layout = mPool.layout();
   RaycastParams p{};
   const glm::dvec3 eye = (camera.eye - h.origin) / h.cellSize;
@@ -176,10 +184,9 @@ RenderResult FrameRenderer::render(int frame, const Camera& camera, int directio
 RenderStats FrameRenderer::trace(int frame, const Camera& camera, int direction) {
   const auto start = Clock::now();
   validate(camera, "camera");
-  if (!mStore.hasFrame(frame))
-    throw InputError(mStore.directory().string() + ": the store has no frame " + std::to_string(frame));
-  const auto index = mStore.frame(frame);
-  const StoreHeader& header = mStore.header();
+  if (!mSource->hasFrame(frame)) throw InputError(mSource->name() + ": no frame " + std::to_string(frame));
+  const auto index = mSource->frame(frame);
+  const StoreHeader& header = mSource->header();
 
   RenderStats stats;
   stats.frameBricks = index->bricks.size();
@@ -220,7 +227,7 @@ RenderStats FrameRenderer::trace(int frame, const Camera& camera, int direction)
     while (bricks.size() < wanted.size()) {
       mStreamer->waitIdle();
       auto ready = mStreamer->takeReady(wanted.size());
-      if (mStreamer->stats().failed > failedBefore) throw FileError(mStore.directory(), mStreamer->lastError());
+      if (mStreamer->stats().failed > failedBefore) throw FileError(mSource->name(), mStreamer->lastError());
       if (ready.empty())
         throw LogicError("the streamer delivered " + std::to_string(bricks.size()) + " of " +
                          std::to_string(wanted.size()) + " requested bricks");

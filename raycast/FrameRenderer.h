@@ -1,9 +1,12 @@
 // FrameRenderer: the request-driven frame loop (Reichl et al. 2014 §3.3, §4.4). Each pass traces
 // the pending rays; the bricks they stopped at are converted by the Streamer (or found in its
 // CPU cache), placed in the BrickPool and uploaded, and the next pass resumes the rays, until no
-// ray asks for anything. A cold frame converges in a few passes, a warm one in one.
+// ray asks for anything. A cold frame converges in a few passes, a warm one in one. Bricks,
+// frame indices and the domain come from a BrickSource (streaming/BrickSource.h): a store, or a
+// synthetic source in tests.
 //
-//   FrameRenderer renderer(BrickStore::open(dir), std::make_unique<CpuRaycaster>(), settings);
+//   FrameRenderer renderer(std::make_shared<StoreBrickSource>(BrickStore::open(dir)),
+//                          std::make_unique<CpuRaycaster>(), settings);
 //   RenderResult result = renderer.render(frame, camera);
 //   RenderImage image = shade(result, camera, ShadingOptions{});
 //
@@ -20,6 +23,7 @@
 #include "raycast/BrickPool.h"
 #include "raycast/Camera.h"
 #include "raycast/RaycastDevice.h"
+#include "streaming/BrickSource.h"
 #include "streaming/Streamer.h"
 
 namespace flipscope {
@@ -39,11 +43,15 @@ struct RenderSettings {
 void validate(const RenderSettings& settings);
 /// Cells around a cell whose spheres can reach it: ceil(radius + jitter + 0.5) - 1.
 std::uint32_t sphereReach(float radius, float jitter);
-/// The sphere radius in cells a render takes when none is given: one particle spacing of the
-/// store (StoreHeader::particleSpacing), so neighbouring particles' spheres overlap and a
-/// liquid body renders closed; at least 1 cell, at most what the overlap border allows with
-/// `jitter`; 1 cell when the store records no spacing.
+/// The sphere radius in cells a render takes when none is given: kDefaultRadiusPerSpacing particle
+/// spacings of the store (StoreHeader::particleSpacing), so the spheres of neighbouring particles
+/// overlap and a liquid body renders closed even where a FLIP sheet is one or two particles
+/// thin; at least 1 cell, at most what the overlap border allows with `jitter`; 1 cell when the
+/// store records no spacing.
 float defaultSphereRadius(const StoreHeader& header, float jitter);
+/// 1.5: Blender's Mantaflow meshes its particles with a radius of one simulation voxel, about 1.6
+/// particle spacings at its default of 8 particles per voxel.
+inline constexpr double kDefaultRadiusPerSpacing = 1.5;
 
 struct RenderStats {
   int passes = 0;
@@ -69,17 +77,21 @@ struct RenderResult {
 
 class FrameRenderer {
  public:
-  FrameRenderer(BrickStore store, std::unique_ptr<RaycastDevice> device, const RenderSettings& settings);
+  /// `source` is shared with the renderer's Streamer (its workers read() from it). Throws
+  /// InputError for bad settings.
+  FrameRenderer(std::shared_ptr<BrickSource> source, std::unique_ptr<RaycastDevice> device,
+                const RenderSettings& settings);
   ~FrameRenderer();
 
-  /// Renders `frame` (InputError when the store has no such frame). `direction` (+1, -1, 0)
-  /// steers the Streamer's read-ahead.
+  /// Renders `frame` (InputError when the source has no such frame; FileError naming the
+  /// source when a brick cannot be read). `direction` (+1, -1, 0) steers the Streamer's
+  /// read-ahead.
   RenderResult render(int frame, const Camera& camera, int direction = 0);
   /// render() without reading the hits back: they stay on the device for the screen-space
   /// stages (pipeline/FramePipeline.h).
   RenderStats trace(int frame, const Camera& camera, int direction = 0);
 
-  const BrickStore& store() const { return mStore; }
+  BrickSource& source() const { return *mSource; }
   RaycastDevice& device() { return *mDevice; }
   const RenderSettings& settings() const { return mSettings; }
   const Streamer& streamer() const { return *mStreamer; }
@@ -94,7 +106,7 @@ class FrameRenderer {
  private:
   std::vector<std::uint32_t> pageTable(const FrameIndex& frame) const;
 
-  BrickStore mStore;
+  std::shared_ptr<BrickSource> mSource;
   std::unique_ptr<RaycastDevice> mDevice;
   RenderSettings mSettings;
   std::uint32_t mReach = 0;

@@ -1,7 +1,14 @@
-// Adapter from the brick store to the Streamer's BrickSource (Reichl et al. 2014 §3.1).
+// Adapter from the brick store to BrickSource (Reichl et al. 2014 §3.1).
 #include "streaming/BrickSource.h"
 
+#include <algorithm>
+
 namespace flipscope {
+
+bool BrickSource::hasFrame(int frame) const {
+  const std::vector<int> all = frames();
+  return std::binary_search(all.begin(), all.end(), frame);
+}
 
 std::shared_ptr<const DecodedBrick> StoreBrickSource::read(const BrickKey& key) {
   if (!mStore.hasFrame(key.frame)) return nullptr;

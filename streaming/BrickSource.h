@@ -1,11 +1,19 @@
-// Where the Streamer gets decoded bricks from: an interface, so tests and benchmarks need no
-// store, and its adapter over the preprocess BrickStore (Reichl et al. 2014 §3.1: the CPU
-// converts bricks on request from the binned particles).
+// Where bricks come from: an interface, so the Streamer, the frame renderer
+// (raycast/FrameRenderer.h) and the frame pipeline run on a synthetic source in tests and
+// benchmarks as well as on a store, and its adapter over the preprocess BrickStore (Reichl et al.
+// 2014 §3.1: the CPU converts bricks on request from the binned particles).
+//
+// A source describes a fixed domain (the store-wide StoreHeader: brick size, brick grid,
+// origin, cell size, attribute kind) and a set of frames; each frame has an index (its
+// non-empty bricks in Morton order and the presence octree over them, PresenceOctree.h) and
+// the particles of each of those bricks. Everything a renderer needs comes through here.
 #pragma once
 
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include <glm/vec3.hpp>
 
@@ -29,22 +37,54 @@ struct BrickKeyHash {
   }
 };
 
-/// Thread safety: read() is called concurrently from the Streamer's workers.
+/// Contract:
+/// - header() is the same for the source's lifetime and for every frame. Its brick size is 32,
+///   64 or 128, its brick grid below kMortonAxisLimit per axis, its cell size > 0; `version` and
+///   `particleSpacing` (0: unknown) are informative only.
+/// - frames() lists the frame numbers, ascending and unique; hasFrame(f) agrees with it.
+/// - frame(f) is the same index on every call for the source's lifetime: frame == f, `bricks`
+///   are exactly the bricks whose read() returns particles, unique, in ascending Morton order of
+///   their coordinates (core/Morton.h), each with its particle and cell counts, and `octree` is
+///   PresenceOctree::build over those codes for the largest axis of the brick grid. `file` and
+///   `fileBytes` may be empty / 0 for a source without files.
+/// - read(key) returns the particles of a brick listed in frame(key.frame), the same on every
+///   call, and nullptr for every other key.
+/// Thread safety: every member may be called from any number of threads at once (the
+/// Streamer's workers read() while the renderer asks for frame indices).
 class BrickSource {
  public:
   virtual ~BrickSource() = default;
-  virtual std::uint32_t brickSize() const = 0;
+
+  /// The store-wide constants: domain (origin, cell size, brick grid), brick size, attribute.
+  virtual const StoreHeader& header() const = 0;
+  std::uint32_t brickSize() const { return header().brickSize; }
+  /// Frame numbers present, ascending.
+  virtual std::vector<int> frames() const = 0;
+  virtual bool hasFrame(int frame) const;
+  /// The frame's index (bricks and presence octree, see the contract above). Throws InputError
+  /// when the source has no such frame, FileError when a store's index is corrupted.
+  virtual std::shared_ptr<const FrameIndex> frame(int frame) const = 0;
   /// The brick's particles, or nullptr when the brick is empty, outside the grid, or the frame
   /// does not exist. Throws FileError on a corrupted store.
   virtual std::shared_ptr<const DecodedBrick> read(const BrickKey& key) = 0;
+  /// What error messages call the source: a store's directory, or a synthetic source's
+  /// description.
+  virtual std::string name() const = 0;
 };
 
-/// Reads bricks from a BrickStore through each frame's presence octree.
+/// Reads bricks from a BrickStore through each frame's presence octree. name() is the store
+/// directory.
 class StoreBrickSource : public BrickSource {
  public:
   explicit StoreBrickSource(BrickStore store) : mStore(std::move(store)) {}
-  std::uint32_t brickSize() const override { return mStore.header().brickSize; }
+  const StoreHeader& header() const override { return mStore.header(); }
+  std::vector<int> frames() const override { return mStore.frames(); }
+  bool hasFrame(int frame) const override { return mStore.hasFrame(frame); }
+  std::shared_ptr<const FrameIndex> frame(int frame) const override { return mStore.frame(frame); }
   std::shared_ptr<const DecodedBrick> read(const BrickKey& key) override;
+  std::string name() const override { return mStore.directory().string(); }
+
+  const BrickStore& store() const { return mStore; }
 
  private:
   BrickStore mStore;

@@ -1,14 +1,38 @@
-// Synthetic wave-tank bricks for the Streamer's tests and benchmark.
+// Synthetic wave-tank bricks for the Streamer's, the renderer's and the pipeline's tests and
+// benchmarks.
 #include "streaming/SyntheticBrickSource.h"
 
+#include <algorithm>
 #include <cmath>
 
+#include "core/Error.h"
+#include "core/Morton.h"
 #include "streaming/Jitter.h"
 
 namespace flipscope {
 
 SyntheticBrickSource::SyntheticBrickSource(std::uint32_t brickSize, glm::uvec3 grid, int frames, double fill)
-    : mBrickSize(brickSize), mGrid(grid), mFrames(frames), mFill(fill) {}
+    : mBrickSize(brickSize), mGrid(grid), mFrames(frames), mFill(fill) {
+  FLIPSCOPE_CHECK(grid.x < kMortonAxisLimit && grid.y < kMortonAxisLimit && grid.z < kMortonAxisLimit,
+                  "synthetic brick grid " << grid.x << "x" << grid.y << "x" << grid.z);
+  mHeader.brickSize = brickSize;
+  mHeader.cellSize = kCellSize;
+  mHeader.brickGrid = grid;
+  mHeader.origin = glm::dvec3(-0.5 * grid.x * brickSize * kCellSize, -0.5 * grid.y * brickSize * kCellSize, 0.0);
+  mHeader.attribute = AttributeKind::Speed;
+  mHeader.particleSpacing = 0;
+}
+
+std::vector<int> SyntheticBrickSource::frames() const {
+  std::vector<int> out;
+  for (int f = 0; f < mFrames; ++f) out.push_back(f);
+  return out;
+}
+
+std::string SyntheticBrickSource::name() const {
+  return "synthetic wave tank (" + std::to_string(mGrid.x) + "x" + std::to_string(mGrid.y) + "x" +
+         std::to_string(mGrid.z) + " bricks of " + std::to_string(mBrickSize) + ")";
+}
 
 double SyntheticBrickSource::surfaceHeight(int frame, double x, double y) const {
   double size = double(mBrickSize);
@@ -17,7 +41,7 @@ double SyntheticBrickSource::surfaceHeight(int frame, double x, double y) const 
   return extent * (0.45 + 0.2 * std::sin(x / (2.3 * size) + phase) * std::cos(y / (1.7 * size) - 0.5 * phase));
 }
 
-std::shared_ptr<const DecodedBrick> SyntheticBrickSource::read(const BrickKey& key) {
+std::shared_ptr<const DecodedBrick> SyntheticBrickSource::decode(const BrickKey& key) const {
   if (key.frame < 0 || key.frame >= mFrames) return nullptr;
   if (key.coord.x >= mGrid.x || key.coord.y >= mGrid.y || key.coord.z >= mGrid.z) return nullptr;
   const std::uint32_t b = mBrickSize;
@@ -57,6 +81,37 @@ std::vector<glm::uvec3> SyntheticBrickSource::bricks(int frame) const {
         if (below) out.push_back({x, y, z});
       }
   return out;
+}
+
+std::shared_ptr<const FrameIndex> SyntheticBrickSource::frame(int frame) const {
+  if (!hasFrame(frame)) throw InputError(name() + ": no frame " + std::to_string(frame));
+  {
+    std::lock_guard lock(mMutex);
+    if (auto it = mIndices.find(frame); it != mIndices.end()) return it->second;
+  }
+  // The candidates from the analytic surface, decoded: only bricks that draw particles are
+  // listed, in Morton order, as a store's frame file would list them.
+  std::vector<std::pair<std::uint32_t, glm::uvec3>> candidates;
+  for (glm::uvec3 c : bricks(frame)) candidates.emplace_back(mortonEncode3(c.x, c.y, c.z), c);
+  std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  auto index = std::make_shared<FrameIndex>();
+  index->frame = frame;
+  std::vector<std::uint32_t> codes;
+  for (const auto& [code, coord] : candidates) {
+    const auto brick = decode({frame, coord});
+    if (!brick) continue;
+    BrickRecord record;
+    record.coord = coord;
+    record.particles = std::uint32_t(brick->particleCount());
+    record.cells = std::uint32_t(brick->cells.size());
+    index->bricks.push_back(record);
+    index->stats.particles += record.particles;
+    codes.push_back(code);
+  }
+  index->stats.attributeMax = 1.0f;  // speeds are synthetic: quantized 65535 reads as 1
+  index->octree = PresenceOctree::build(codes, std::max({mGrid.x, mGrid.y, mGrid.z}));
+  std::lock_guard lock(mMutex);
+  return mIndices.emplace(frame, std::move(index)).first->second;
 }
 
 }  // namespace flipscope

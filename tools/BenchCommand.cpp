@@ -10,6 +10,7 @@ void addBenchCommand(CLI::App& app) {
   addBenchPreprocessCommand(*bench);
   addBenchStreamingCommand(*bench);
   addBenchRenderCommand(*bench);
+  addBenchSurfaceCommand(*bench);
 }
 
 }  // namespace flipscope::tools

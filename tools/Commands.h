@@ -21,7 +21,7 @@ class CommandFailed : public std::runtime_error {
 void addConvertCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);
 void addSynthCommand(CLI::App& app);
-void addBenchCommand(CLI::App& app);  // creates `bench` and calls the three below
+void addBenchCommand(CLI::App& app);  // creates `bench` and calls the four below
 void addRenderCommand(CLI::App& app);
 void addDemoCommand(CLI::App& app);
 
@@ -29,5 +29,6 @@ void addDemoCommand(CLI::App& app);
 void addBenchPreprocessCommand(CLI::App& bench);
 void addBenchStreamingCommand(CLI::App& bench);
 void addBenchRenderCommand(CLI::App& bench);
+void addBenchSurfaceCommand(CLI::App& bench);
 
 }  // namespace flipscope::tools

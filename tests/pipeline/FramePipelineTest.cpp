@@ -2,12 +2,15 @@
 // normals and shading.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "TestSupport.h"
 #include "core/Error.h"
 #include "pipeline/FramePipeline.h"
 #include "raycast/RaycastScenes.h"
+#include "streaming/SyntheticBrickSource.h"
 
 namespace flipscope {
 namespace {
@@ -92,6 +95,81 @@ TEST(FramePipeline, EnvironmentMapErrorsNameTheFile) {
   } catch (const FileError& e) {
     EXPECT_NE(std::string(e.what()).find("missing.exr"), std::string::npos) << e.what();
   }
+}
+
+TEST(FramePipeline, RendersASyntheticSourceWithoutAStore) {
+  // The wave tank (128 x 128 cells, 64 high, water 16..42 cells deep) seen straight down from
+  // above its centre: the water is a square in the middle of the image, the sky on either side.
+  auto source = std::make_shared<SyntheticBrickSource>(32, glm::uvec3(4, 4, 2), 1, 0.3);
+  const StoreHeader& h = source->header();
+  const double cell = h.cellSize;
+  const glm::dvec3 lo = h.origin, hi = h.domainMax();
+  SurfaceSettings surface;
+  surface.up = {0, 0, 1};
+  const RenderSettings settings = testing::smallSettings();
+  FramePipeline pipeline(source, DeviceChoice::Cpu, settings, surface);
+  Camera camera;
+  camera.target = glm::dvec3(0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), 0);
+  camera.eye = camera.target + glm::dvec3(0, 0, 3.0);
+  camera.up = {0, 1, 0};
+  const FrameOutput out = pipeline.render(0, camera);
+  ASSERT_TRUE(out.stats.converged);
+  const RenderImage& image = out.image;
+  ASSERT_EQ(image.depth.size(), std::size_t(settings.width) * settings.height);
+
+  // Slab test: does the ray from the eye along `dir` cross the box [a, b]?
+  const auto crosses = [&](glm::dvec3 dir, glm::dvec3 a, glm::dvec3 b) {
+    double near = 0, far = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 3; ++k) {
+      if (dir[k] == 0) {
+        if (camera.eye[k] < a[k] || camera.eye[k] > b[k]) return false;
+        continue;
+      }
+      double t0 = (a[k] - camera.eye[k]) / dir[k], t1 = (b[k] - camera.eye[k]) / dir[k];
+      if (t0 > t1) std::swap(t0, t1);
+      near = std::max(near, t0);
+      far = std::min(far, t1);
+    }
+    return near <= far;
+  };
+  const glm::dvec3 margin(4 * cell);
+  int water = 0, inner = 0;
+  for (std::uint32_t y = 0; y < image.height; ++y)
+    for (std::uint32_t x = 0; x < image.width; ++x) {
+      const std::size_t i = y * image.width + x;
+      const glm::dvec3 dir = camera.pixelRay(x, y, image.width, image.height);
+      const bool foreground = std::isfinite(image.depth[i]);
+      water += foreground;
+      // Where the water lies at least 14 cells deep along the ray (it is 16 cells deep or more
+      // everywhere), every ray meets a particle's sphere.
+      const glm::dvec3 at = camera.eye + dir * ((2 * cell - camera.eye.z) / dir.z);  // 2 cells above the floor
+      if (at.x > lo.x + margin.x && at.x < hi.x - margin.x && at.y > lo.y + margin.y && at.y < hi.y - margin.y) {
+        ++inner;
+        EXPECT_TRUE(foreground) << "pixel " << x << "," << y << " over the water";
+      }
+      // A ray that misses the tank (grown by a few cells) sees the sky.
+      if (!crosses(dir, lo - margin, hi + margin)) {
+        EXPECT_FALSE(foreground) << "pixel " << x << "," << y << " beside the tank";
+      }
+      if (!foreground) {
+        EXPECT_FALSE(std::isfinite(image.unsmoothedDepth[i])) << x << "," << y;
+        continue;
+      }
+      EXPECT_TRUE(std::isfinite(image.unsmoothedDepth[i])) << x << "," << y;
+      EXPECT_TRUE(std::isfinite(image.normal[i].x) && std::isfinite(image.normal[i].y) &&
+                  std::isfinite(image.normal[i].z))
+          << x << "," << y;
+      // The hit lies on the analytic surface: below its wave crest plus a sphere (and jitter),
+      // and not far under it.
+      const glm::dvec3 hit = camera.eye + dir * (double(image.unsmoothedDepth[i]) / glm::dot(dir, camera.forward()));
+      const glm::dvec3 hitCell = (hit - h.origin) / cell;
+      const double height = source->surfaceHeight(0, std::floor(hitCell.x), std::floor(hitCell.y));
+      EXPECT_LE(hitCell.z, height + 3.0) << x << "," << y;
+      EXPECT_GE(hitCell.z, height - 16.0) << x << "," << y;
+    }
+  EXPECT_GT(inner, 1500);
+  EXPECT_GE(water, inner);
+  EXPECT_LT(water, int(image.width * image.height) / 2);
 }
 
 }  // namespace

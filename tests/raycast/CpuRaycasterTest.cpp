@@ -12,6 +12,7 @@
 #include "core/Error.h"
 #include "raycast/CpuRaycaster.h"
 #include "streaming/Jitter.h"
+#include "streaming/SyntheticBrickSource.h"
 
 namespace flipscope {
 namespace {
@@ -33,7 +34,8 @@ std::string firstDifference(const std::vector<RayHit>& a, const std::vector<RayH
 using testing::TempDir;
 
 std::unique_ptr<FrameRenderer> cpuRenderer(const BrickStore& store, const RenderSettings& settings) {
-  return std::make_unique<FrameRenderer>(store, std::make_unique<CpuRaycaster>(), settings);
+  return std::make_unique<FrameRenderer>(std::make_shared<StoreBrickSource>(store), std::make_unique<CpuRaycaster>(),
+                                         settings);
 }
 
 TEST(CpuRaycaster, BallRendersAsDiskWithAnalyticDepth) {
@@ -201,6 +203,54 @@ TEST(FrameRenderer, RejectsMissingFramesAndBadSettings) {
   settings = testing::smallSettings();
   settings.gpuBudgetBytes = 1000;
   EXPECT_THROW(cpuRenderer(store, settings), InputError);
+}
+
+TEST(FrameRenderer, ConvergesOverASyntheticSource) {
+  // No store: the wave tank's bricks, frame indices and domain come from the source itself.
+  auto source = std::make_shared<SyntheticBrickSource>(32, glm::uvec3(4, 4, 2), 2, 0.3);
+  const StoreHeader& h = source->header();
+  const RenderSettings settings = testing::smallSettings();
+  FrameRenderer renderer(source, std::make_unique<CpuRaycaster>(), settings);
+  EXPECT_EQ(&renderer.source(), source.get());
+  // The water fills the tank's footprint from the floor up to below the highest wave.
+  const Box bounds = renderer.occupiedBounds(0, 1);
+  const double cell = h.cellSize;
+  EXPECT_NEAR(bounds.min.x, h.origin.x, 1e-9);
+  EXPECT_NEAR(bounds.min.y, h.origin.y, 1e-9);
+  EXPECT_NEAR(bounds.min.z, h.origin.z, 1e-9);
+  EXPECT_NEAR(bounds.max.x, h.origin.x + 128 * cell, 1e-9);
+  EXPECT_NEAR(bounds.max.y, h.origin.y + 128 * cell, 1e-9);
+  EXPECT_GT(bounds.max.z, 0.45 * 64 * cell);
+  EXPECT_LE(bounds.max.z, (0.65 * 64 + 1) * cell);
+
+  const Camera camera = frameOnBox(bounds, double(settings.width) / settings.height, {0, 0, 1});
+  for (int frame : {0, 1}) {
+    const RenderResult cold = renderer.render(frame, camera);
+    ASSERT_TRUE(cold.stats.converged) << "frame " << frame;
+    EXPECT_GT(cold.stats.passes, 1);
+    EXPECT_GT(cold.stats.bricksUploaded, 0u);
+    EXPECT_EQ(cold.stats.frameBricks, source->frame(frame)->bricks.size());
+    std::size_t hits = 0;
+    for (const RayHit& hit : cold.hits) {
+      ASSERT_NE(hit.status, kRayPending);
+      hits += hit.status == kRayHit;
+    }
+    // frameOnBox fits the box with a margin: the water covers a good part of the image, not all.
+    EXPECT_GT(hits, cold.hits.size() / 5) << "frame " << frame;
+    EXPECT_LT(hits, cold.hits.size()) << "frame " << frame;
+    const RenderResult warm = renderer.render(frame, camera);
+    EXPECT_EQ(warm.stats.passes, 1);
+    EXPECT_EQ(warm.stats.bricksUploaded, 0u);
+    ASSERT_EQ(cold.hits.size(), warm.hits.size());
+    EXPECT_EQ(0, std::memcmp(cold.hits.data(), warm.hits.data(), cold.hits.size() * sizeof(RayHit)))
+        << firstDifference(cold.hits, warm.hits);
+  }
+  try {
+    renderer.render(2, camera);
+    FAIL() << "frame 2 rendered";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(source->name()), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

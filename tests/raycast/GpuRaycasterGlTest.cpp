@@ -18,7 +18,8 @@ using testing::TempDir;
 /// A GPU renderer, or nullptr with the reason in `skip`.
 std::unique_ptr<FrameRenderer> gpuRenderer(const BrickStore& store, const RenderSettings& settings, std::string& skip) {
   try {
-    return std::make_unique<FrameRenderer>(store, std::make_unique<GpuRaycaster>(), settings);
+    return std::make_unique<FrameRenderer>(std::make_shared<StoreBrickSource>(store), std::make_unique<GpuRaycaster>(),
+                                           settings);
   } catch (const gl::Unavailable& e) {
     skip = e.what();
     return nullptr;
@@ -82,7 +83,7 @@ TEST_P(GpuRaycasterScenes, EqualsTheCpuReference) {
   settings.radius = seed % 2 ? 1.5f : 0.8f;
   settings.jitter = seed % 3 ? 0.4f : 0.0f;
   GPU_RENDERER(gpu, store, settings);
-  FrameRenderer cpu(store, std::make_unique<CpuRaycaster>(), settings);
+  FrameRenderer cpu(std::make_shared<StoreBrickSource>(store), std::make_unique<CpuRaycaster>(), settings);
   Camera camera = frameOnBox(cpu.occupiedBounds(0), double(settings.width) / settings.height);
   camera.eye += glm::dvec3(seed * 7.0, -seed * 3.0, seed * 5.0);
   const RenderResult g = gpu->render(0, camera);

@@ -1,10 +1,12 @@
 // StoreBrickSource reads the same bricks back that were written to a BrickStore, and the
-// Streamer over it converts them like over the in-memory source.
+// Streamer over it converts them like over the in-memory source; the synthetic source's frame
+// index is the one a store holds for the same bricks.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <filesystem>
 
+#include "core/Error.h"
 #include "core/Morton.h"
 #include "preprocess/FrameFile.h"
 #include "streaming/Streamer.h"
@@ -92,6 +94,46 @@ TEST_F(StoreBrickSourceTest, StreamerOverTheStoreMatchesTheInMemorySource) {
     EXPECT_EQ(a[i]->bits, b[i]->bits);
   }
   EXPECT_EQ(fromStore.stats().failed, 0u) << fromStore.lastError();
+}
+
+TEST_F(StoreBrickSourceTest, SyntheticFrameIndexIsTheStoresIndex) {
+  StoreBrickSource store(BrickStore::open(mDir));
+  EXPECT_EQ(store.name(), mDir.string());
+  EXPECT_EQ(store.frames(), std::vector<int>{1});
+  EXPECT_TRUE(store.hasFrame(1));
+  EXPECT_FALSE(store.hasFrame(0));
+  const auto expected = store.frame(1);
+  const auto index = mSynthetic.frame(1);
+  EXPECT_EQ(index->frame, 1);
+  ASSERT_EQ(index->bricks.size(), expected->bricks.size());
+  ASSERT_FALSE(index->bricks.empty());
+  for (std::size_t i = 0; i < index->bricks.size(); ++i) {
+    EXPECT_EQ(index->bricks[i].coord, expected->bricks[i].coord) << i;
+    EXPECT_EQ(index->bricks[i].particles, expected->bricks[i].particles) << i;
+    EXPECT_EQ(index->bricks[i].cells, expected->bricks[i].cells) << i;
+  }
+  EXPECT_EQ(index->octree.levels, expected->octree.levels);
+  EXPECT_EQ(index->octree.nodes, expected->octree.nodes);
+  EXPECT_EQ(index->stats.particles, expected->stats.particles);
+  EXPECT_EQ(mSynthetic.frame(1), index) << "computed once, then cached";
+  // Exactly the listed bricks read as non-empty.
+  for (std::uint32_t z = 0; z < mGrid.z; ++z)
+    for (std::uint32_t y = 0; y < mGrid.y; ++y)
+      for (std::uint32_t x = 0; x < mGrid.x; ++x)
+        EXPECT_EQ(mSynthetic.read({1, {x, y, z}}) != nullptr, index->octree.find({x, y, z}) >= 0)
+            << x << "," << y << "," << z;
+
+  const StoreHeader& h = mSynthetic.header();
+  EXPECT_EQ(h.brickSize, 32u);
+  EXPECT_EQ(h.brickGrid, mGrid);
+  EXPECT_EQ(h.cellSize, SyntheticBrickSource::kCellSize);
+  EXPECT_EQ(h.attribute, AttributeKind::Speed);
+  EXPECT_EQ(h.origin, glm::dvec3(-0.48, -0.48, 0.0));  // centred on the z axis, floor at z = 0
+  EXPECT_EQ(mSynthetic.frames(), (std::vector<int>{0, 1, 2}));
+  EXPECT_TRUE(mSynthetic.hasFrame(2));
+  EXPECT_FALSE(mSynthetic.hasFrame(3));
+  EXPECT_THROW(mSynthetic.frame(3), InputError);
+  EXPECT_THROW(store.frame(0), InputError);
 }
 
 }  // namespace
