@@ -20,7 +20,7 @@ struct Entry {
 const std::vector<Entry>& entries() {
   static const std::vector<Entry> table = {
       {{"rof", "adaptive ROF total-variation smoothing, Chambolle's projection (Reichl et al. 2014 Sec. 3.4)",
-        "k in lambda0 = k * focal length * radius^2: bumps lowered by about 2k particle radii", 75, 10000, 8.0f,
+        "k in lambda0 = k * focal length * radius^2 (eq. 7): larger smooths more, at any scale or zoom", 75, 10000, 8.0f,
         0.0f, 1000.0f},
        detail::makeRofFilter},
       {{"bilateral", "depth-adaptive bilateral Gaussian with a world-space kernel (Green 2010, GDC)",

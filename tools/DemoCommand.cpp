@@ -40,6 +40,7 @@ void runDemo(const DemoArgs& a) {
   ConvertOptions options;
   options.cellSize = first.cellSize();
   options.domain = first.domain();
+  options.particleSpacing = first.cellSize() / 2;  // the body lattice (SynthFluid.h)
   StoreHeader header = makeStoreHeader(*options.domain, options, true);
   BrickStore store = BrickStore::createOrAppend(storeDir, header);
   std::printf("demo: %d synth frames of %s particles (FLIP-like wave, sheets, spray) -> %s\n", a.frames,

@@ -52,7 +52,10 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
     if (!fallback.empty()) std::fprintf(stderr, "render: using the CPU reference: %s\n", fallback.c_str());
     const SmoothingOptions& smoothing = resolve(surface.smoothing);
     std::printf("render: %s; sphere radius %.3g cells%s; smoothing %s (%d iterations, strength %g)\n",
-                pipeline.deviceName().c_str(), settings.radius, job.radius ? "" : " (from the store's particle spacing)",
+                pipeline.deviceName().c_str(), settings.radius,
+                job.radius                              ? ""
+                : store.header().particleSpacing > 0 ? " (1.5 particle spacings of the store)"
+                                                     : " (the store records no particle spacing)",
                 smoothing.name.c_str(), smoothing.iterations, smoothing.strength);
   }
 

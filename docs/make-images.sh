@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Renders every picture of the README into docs/images/ with the commands below (each picture's
+# command is also written next to it in the README). Run from the repository root after a
+# build: docs/make-images.sh [build/flipscope]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+flipscope=${1:-build/flipscope}
+out=docs/images
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+mkdir -p "$out"
+
+# The bundled Blender Mantaflow FLIP frame (tests/data), converted and rendered with defaults.
+vdb=tests/data/mantaflow-dam64/data/fluid_data_0030.vdb
+"$flipscope" convert "$vdb" -o "$work/dam" -q
+"$flipscope" render "$work/dam" -o "$out/mantaflow-liquid.png" --up z --size 640x360 -q
+"$flipscope" render "$work/dam" -o "$out/mantaflow-spheres.png" --up z --size 640x360 --shading spheres -q
+"$flipscope" render "$work/dam" -o "$out/mantaflow-unsmoothed.png" --up z --size 640x360 --smoothing none -q
+
+# The five filters side by side on the same frame and camera.
+for filter in rof bilateral curvature-flow narrow-range plane-fit; do
+  "$flipscope" render "$work/dam" -o "$out/filter-$filter.png" --up z --size 480x270 --smoothing "$filter" -q
+done
+
+# A large synth frame: 20 M particles of waves, sheets and spray.
+"$flipscope" synth -o "$work/wave.bin" --particles 20M >/dev/null
+"$flipscope" convert "$work/wave.bin" -o "$work/wave" -q
+"$flipscope" render "$work/wave" -o "$out/synth20m-liquid.png" --size 640x360 -q
+"$flipscope" render "$work/wave" -o "$out/synth20m-unsmoothed.png" --size 640x360 --smoothing none -q
+echo "docs/make-images.sh: wrote $(ls "$out" | wc -l) pictures to $out"
