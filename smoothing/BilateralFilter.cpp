@@ -21,11 +21,10 @@
 // is. Iterations. --smoothing-iterations n applies the filter n times (default 1, at most 10);
 // 0 leaves the depth as it is.
 #include <cstddef>
-#include <optional>
-#include <utility>
 
 #include "smoothing/detail/CpuScreenKernel.h"
 #include "smoothing/detail/Filters.h"
+#include "smoothing/detail/PassChain.h"
 
 namespace flipscope {
 
@@ -52,30 +51,18 @@ class BilateralFilter : public SurfaceFilter {
   explicit BilateralFilter(const SmoothingOptions& options) : mOptions(options) {}
 
   void apply(ScreenDevice& device, ScreenImage depth, ScreenImage output) override {
-    if (mOptions.iterations == 0) {
-      device.copy(depth, output);
-      return;
-    }
-    if (mOptions.iterations > 1 && !mScratch) {
-      mScratch = {device.createFrameImage(), device.createFrameImage()};
-    }
     const float r = device.frame().particleRadius;
     glsl::BilateralParams params{};
     params.worldRadius = mOptions.strength * r;
     params.maxRadius = kMaxRadius;
     params.sigmaDepth = 0.5f * mOptions.strength * r;  // the spatial sigma, R / 2, in world units
-    ScreenImage source = depth;
-    for (int i = 0; i < mOptions.iterations; ++i) {
-      const ScreenImage target =
-          i + 1 == mOptions.iterations ? output : (i % 2 == 0 ? mScratch->first : mScratch->second);
-      device.run(kBilateral, params, {source}, target);
-      source = target;
-    }
+    mChain.run(device, depth, output, mOptions.iterations,
+               [&](int, ScreenImage from, ScreenImage to) { device.run(kBilateral, params, {from}, to); });
   }
 
  private:
   SmoothingOptions mOptions;
-  std::optional<std::pair<ScreenImage, ScreenImage>> mScratch;
+  PassChain mChain;
 };
 }  // namespace
 

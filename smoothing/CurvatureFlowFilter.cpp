@@ -26,6 +26,7 @@
 
 #include "smoothing/detail/CpuScreenKernel.h"
 #include "smoothing/detail/Filters.h"
+#include "smoothing/detail/PassChain.h"
 
 namespace flipscope {
 
@@ -57,14 +58,7 @@ class CurvatureFlowFilter : public SurfaceFilter {
   explicit CurvatureFlowFilter(const SmoothingOptions& options) : mOptions(options) {}
 
   void apply(ScreenDevice& device, ScreenImage depth, ScreenImage output) override {
-    if (mOptions.iterations == 0) {
-      device.copy(depth, output);
-      return;
-    }
-    if (!mLinks) {
-      mLinks = device.createFrameImage();
-      for (ScreenImage& image : mSteps) image = device.createFrameImage();
-    }
+    if (!mLinks) mLinks = device.createFrameImage();
     const ScreenFrame& frame = device.frame();
     glsl::CurvatureFlowParams params{};
     params.cx = 2.0f * frame.forward.w * frame.right.w / float(frame.size.x);
@@ -73,18 +67,15 @@ class CurvatureFlowFilter : public SurfaceFilter {
     params.jumpBase = kJumpRadii * frame.particleRadius;
     params.jumpPerDepth = kJumpFootprints * std::max(params.cx, params.cy);
     device.run(kLinks, params, {depth}, *mLinks);
-    ScreenImage current = depth;
-    for (int i = 0; i < mOptions.iterations; ++i) {
-      const ScreenImage next = i + 1 == mOptions.iterations ? output : mSteps[i % 2];
-      device.run(kStep, params, {current, *mLinks}, next);
-      current = next;
-    }
+    mChain.run(device, depth, output, mOptions.iterations, [&](int, ScreenImage from, ScreenImage to) {
+      device.run(kStep, params, {from, *mLinks}, to);
+    });
   }
 
  private:
   SmoothingOptions mOptions;
   std::optional<ScreenImage> mLinks;
-  ScreenImage mSteps[2] = {};
+  PassChain mChain;
 };
 }  // namespace
 

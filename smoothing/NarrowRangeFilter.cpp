@@ -27,12 +27,10 @@
 // --smoothing-iterations n: n - 1 separable iterations (x then y) and one final 2D pass; default
 // 4 (Oliveira and Paiva, Sec. 5), at most 20; 0 leaves the depth as it is.
 #include <cstddef>
-#include <optional>
-#include <utility>
-#include <vector>
 
 #include "smoothing/detail/CpuScreenKernel.h"
 #include "smoothing/detail/Filters.h"
+#include "smoothing/detail/PassChain.h"
 
 namespace flipscope {
 
@@ -67,11 +65,6 @@ class NarrowRangeFilter : public SurfaceFilter {
   explicit NarrowRangeFilter(const SmoothingOptions& options) : mOptions(options) {}
 
   void apply(ScreenDevice& device, ScreenImage depth, ScreenImage output) override {
-    if (mOptions.iterations == 0) {
-      device.copy(depth, output);
-      return;
-    }
-    if (mOptions.iterations > 1 && !mScratch) mScratch = {device.createFrameImage(), device.createFrameImage()};
     const float r = device.frame().particleRadius;
     glsl::NarrowRangeParams base{};
     base.worldRadius = mOptions.strength * r;
@@ -82,25 +75,20 @@ class NarrowRangeFilter : public SurfaceFilter {
     alongX.axisX = 1;
     alongY.axisY = 1;
     full.maxRadius = kMaxRadius2D;
-
-    std::vector<std::pair<const ScreenPass*, glsl::NarrowRangeParams>> passes;
-    for (int i = 0; i + 1 < mOptions.iterations; ++i) {
-      passes.emplace_back(&kPass1D, alongX);
-      passes.emplace_back(&kPass1D, alongY);
-    }
-    passes.emplace_back(&kPass2D, full);
-
-    ScreenImage source = depth;
-    for (std::size_t i = 0; i < passes.size(); ++i) {
-      const ScreenImage target = i + 1 == passes.size() ? output : (i % 2 == 0 ? mScratch->first : mScratch->second);
-      device.run(*passes[i].first, passes[i].second, {source}, target);
-      source = target;
-    }
+    // n - 1 pairs of 1D passes (x, then y), then the 2D pass.
+    const int passes = 2 * (mOptions.iterations - 1) + 1;
+    mChain.run(device, depth, output, passes, [&](int i, ScreenImage from, ScreenImage to) {
+      if (i + 1 == passes) {
+        device.run(kPass2D, full, {from}, to);
+      } else {
+        device.run(kPass1D, i % 2 == 0 ? alongX : alongY, {from}, to);
+      }
+    });
   }
 
  private:
   SmoothingOptions mOptions;
-  std::optional<std::pair<ScreenImage, ScreenImage>> mScratch;
+  PassChain mChain;
 };
 }  // namespace
 

@@ -25,6 +25,7 @@
 
 #include "smoothing/detail/CpuScreenKernel.h"
 #include "smoothing/detail/Filters.h"
+#include "smoothing/detail/PassChain.h"
 
 namespace flipscope {
 
@@ -53,35 +54,25 @@ class PlaneFitFilter : public SurfaceFilter {
   explicit PlaneFitFilter(const SmoothingOptions& options) : mOptions(options) {}
 
   void apply(ScreenDevice& device, ScreenImage depth, ScreenImage output) override {
-    if (mOptions.iterations == 0) {
-      device.copy(depth, output);
-      return;
-    }
-    if (!mNormals) {
-      mNormals = device.createFrameImage();
-      for (ScreenImage& image : mSteps) image = device.createFrameImage();
-    }
+    if (!mNormals) mNormals = device.createFrameImage();
     const ScreenFrame& frame = device.frame();
     const float r = frame.particleRadius;
     const float sigma = kSigmaRadii * r;
     glsl::PlaneFitParams params{};
-    params.radiusPerDepth = mOptions.strength * r * frame.focalPixels;
+    params.worldRadius = mOptions.strength * r;
     params.maxRadius = kMaxRadiusPixels;
     params.invSigma2 = 1.0f / (sigma * sigma);
     params.moveLimit = 1.0f;
     device.run(kNormals, params, {depth}, *mNormals);
-    ScreenImage current = depth;
-    for (int i = 0; i < mOptions.iterations; ++i) {
-      const ScreenImage next = i + 1 == mOptions.iterations ? output : mSteps[i % 2];
-      device.run(kFit, params, {current, *mNormals}, next);
-      current = next;
-    }
+    mChain.run(device, depth, output, mOptions.iterations, [&](int, ScreenImage from, ScreenImage to) {
+      device.run(kFit, params, {from, *mNormals}, to);
+    });
   }
 
  private:
   SmoothingOptions mOptions;
   std::optional<ScreenImage> mNormals;
-  ScreenImage mSteps[2] = {};
+  PassChain mChain;
 };
 }  // namespace
 

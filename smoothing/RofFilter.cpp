@@ -11,7 +11,8 @@
 // image size: k is a strength in particle radii, independent of the scene's scale. That is the
 // converged result; 75 iterations (the paper's) smooth features up to about 6 pixels across,
 // so on particles much larger than that on screen more iterations smooth further.
-// epsilon = r (world units) keeps lambda finite at the eye.
+// epsilon = r (world units) keeps lambda finite at the eye. k = 0 (lambda = 0, which eq. 2 divides
+// by) leaves the depth as it is: createSurfaceFilter copies it.
 #include <cstddef>
 #include <optional>
 

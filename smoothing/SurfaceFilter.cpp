@@ -93,6 +93,8 @@ SmoothingOptions resolve(const SmoothingOptions& options) {
 
 std::unique_ptr<SurfaceFilter> createSurfaceFilter(const SmoothingOptions& options) {
   const SmoothingOptions resolved = resolve(options);
+  // No strength or no iterations: every filter leaves the depth as it is.
+  if (resolved.strength == 0.0f || resolved.iterations == 0) return detail::makeNoFilter(resolved);
   return find(resolved.name)->make(resolved);
 }
 

@@ -49,7 +49,8 @@ std::string surfaceFilterNames();
 /// The options with every default filled in. Throws InputError naming the option
 /// (--smoothing, --smoothing-iterations, --smoothing-strength) and listing the valid values.
 SmoothingOptions resolve(const SmoothingOptions& options);
-/// The filter (options are resolved first). Throws InputError as resolve() does.
+/// The filter (options are resolved first; at strength 0 or 0 iterations, a copy of the depth).
+/// Throws InputError as resolve() does.
 std::unique_ptr<SurfaceFilter> createSurfaceFilter(const SmoothingOptions& options);
 
 }  // namespace flipscope

@@ -1,5 +1,7 @@
 // The factories of the filters behind createSurfaceFilter (smoothing/SurfaceFilter.cpp), one
-// file each. Options arrive resolved (every default filled in, ranges checked).
+// file each. Options arrive resolved (every default filled in, ranges checked) and with a
+// strength and iterations above 0: without either, createSurfaceFilter copies the depth
+// (makeNoFilter) instead.
 #pragma once
 
 #include <memory>

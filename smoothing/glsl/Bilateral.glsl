@@ -17,7 +17,7 @@ FS_FUNC vec4 bilateral(ivec2 p) {
   vec4 d = ssLoad(0u, p);
   if (d.y < 0.5f) return d;
   float z = d.x;
-  float radius = min(S.worldRadius * F.focalPixels / max(z, 1e-6f), S.maxRadius);
+  float radius = ssPixelsAtDepth(S.worldRadius, z, S.maxRadius);
   // Below one pixel every neighbour lies on or outside the support: the kernel is the identity.
   if (!(radius > 1.0f)) return vec4(z, d.y, 0.0f, 0.0f);
   int n = int(radius);

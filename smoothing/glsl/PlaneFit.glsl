@@ -14,9 +14,10 @@
 //   normals  xyz: n~, the unit normal of the input depth towards the eye (eye space = world
 //            directions about the eye); 0 on the background
 //
-// The window is a disk of radius R = radiusPerDepth / z_i pixels (at most maxRadius), which
-// covers a neighbour at distance rho by clamp(R + 0.5 - rho, 0, 1): the paper's uniform window
-// with an edge one pixel wide, so the fit changes continuously with the depth that sets R.
+// The window is a disk of radius R = worldRadius * focalPixels / z_i pixels (at most
+// maxRadius), which covers a neighbour at distance rho by clamp(R + 0.5 - rho, 0, 1): the
+// paper's uniform window with an edge one pixel wide, so the fit changes continuously with the
+// depth that sets R.
 
 // The eye-space difference of the surface across pixel p along `axis` (input 0: depth): to the
 // neighbour in +axis or -axis whose depth is closer to z (van der Laan et al. 2009 Sec. 5.3.5,
@@ -69,7 +70,7 @@ FS_FUNC vec4 pfFit(ivec2 p) {
   if (d.y < 0.5f || d.x <= 0.0f) return d;
   float z = d.x;
   vec3 here = ssEyeOffset(p, z);
-  float radius = min(S.radiusPerDepth / z, S.maxRadius);
+  float radius = ssPixelsAtDepth(S.worldRadius, z, S.maxRadius);
   int reach = int(radius + 0.5f);
   vec3 normalSum = vec3(0.0f);
   vec3 offsetSum = vec3(0.0f);

@@ -19,3 +19,9 @@ FS_FUNC vec3 ssEyeOffset(ivec2 pixel, float depth) {
 }
 
 FS_FUNC bool ssInside(ivec2 p) { return p.x >= 0 && p.y >= 0 && p.x < int(F.size.x) && p.y < int(F.size.y); }
+
+// The pixels that `worldSize` world units span at linear depth z, at most maxPixels: a kernel of
+// constant world-space size, as wide on screen as it is at that depth.
+FS_FUNC float ssPixelsAtDepth(float worldSize, float z, float maxPixels) {
+  return min(worldSize * F.focalPixels / max(z, 1e-6f), maxPixels);
+}

@@ -1,12 +1,9 @@
-// Properties of the `plane-fit` filter (iterative MLS plane fitting, Imai, Kanamori, Mitani 2016)
-// on the CPU reference: planes are fixed points, untouched background, smoothing towards the
-// exact surface, more smoothing with more iterations or a larger window, stability at the
-// largest settings, preserved depth steps.
+// Properties particular to the `plane-fit` filter (iterative MLS plane fitting, Imai, Kanamori,
+// Mitani 2016) on the CPU reference: a plane in eye space is a fixed point, edges and rims
+// included. What every filter shares (fixed points, untouched background, smoothing towards the
+// exact surface, more smoothing with more iterations or a larger window, stability at the largest
+// settings, depth steps, registry entry): SurfaceFilterPropertiesTest.cpp.
 #include <gtest/gtest.h>
-
-#include <algorithm>
-#include <cmath>
-#include <limits>
 
 #include "smoothing/SmoothingScenes.h"
 
@@ -14,190 +11,25 @@ namespace flipscope {
 namespace {
 
 using testing::DepthScene;
-using testing::kBackgroundDepth;
-using testing::pixelRay;
-using testing::smoothOnCpu;
-using testing::sphereScene;
-using testing::testFrame;
-
-/// Depth `depthAt(x, y)` on the whole frame or a centred disk, exactDepth = depth.
-DepthScene flatScene(std::uint32_t w, std::uint32_t h, auto depthAt, bool disk) {
-  DepthScene s;
-  s.frame = testFrame(w, h);
-  s.depth.assign(std::size_t(w) * h, glm::vec4(kBackgroundDepth, 0, 0, 0));
-  s.exactDepth.assign(s.depth.size(), kBackgroundDepth);
-  for (int y = 0; y < int(h); ++y)
-    for (int x = 0; x < int(w); ++x) {
-      const float dx = x - w / 2.0f, dy = y - h / 2.0f;
-      if (disk && dx * dx + dy * dy > 0.16f * h * h) continue;
-      const std::size_t i = std::size_t(y) * w + x;
-      s.depth[i] = glm::vec4(depthAt(x, y), 1, 0, 0);
-      s.exactDepth[i] = s.depth[i].x;
-    }
-  return s;
-}
-
-SmoothingOptions planeFit(float strength = -1, int iterations = -1) { return {"plane-fit", iterations, strength}; }
-
-/// Mean |5-point Laplacian| of the depth's deviation from the exact depth (the noise, not the
-/// surface's own curvature) over the pixels of a continuous surface: whose four neighbours are
-/// foreground with exact depths within 0.05 (2.5 particle radii) of theirs.
-double roughness(const std::vector<glm::vec4>& d, const DepthScene& s) {
-  const std::uint32_t w = s.frame.size.x, h = s.frame.size.y;
-  double sum = 0;
-  int count = 0;
-  for (std::uint32_t y = 1; y + 1 < h; ++y)
-    for (std::uint32_t x = 1; x + 1 < w; ++x) {
-      const std::size_t i = y * w + x;
-      bool continuous = s.depth[i].y > 0.5f;
-      for (std::size_t j : {i - 1, i + 1, i - w, i + w})
-        continuous = continuous && s.depth[j].y > 0.5f && std::abs(s.exactDepth[j] - s.exactDepth[i]) < 0.05f;
-      if (!continuous) continue;
-      auto e = [&](std::size_t j) { return double(d[j].x) - s.exactDepth[j]; };
-      sum += std::abs(4 * e(i) - e(i - 1) - e(i + 1) - e(i - w) - e(i + w));
-      ++count;
-    }
-  return sum / count;
-}
-
-/// RMS of depth - exact depth over the pixels where the exact surface faces the camera within
-/// 60 degrees (near the rim, where view rays graze the sphere, a depth error is no surface error).
-double errorToExact(const std::vector<glm::vec4>& d, const DepthScene& s) {
-  double sum = 0;
-  int count = 0;
-  for (std::size_t i = 0; i < d.size(); ++i) {
-    if (s.depth[i].y < 0.5f || s.normals[i].z < 0.5f) continue;
-    const double e = d[i].x - s.exactDepth[i];
-    sum += e * e;
-    ++count;
-  }
-  return std::sqrt(sum / count);
-}
-
-double worstDifference(const std::vector<glm::vec4>& out, const DepthScene& s) {
-  double worst = 0;
-  for (std::size_t i = 0; i < out.size(); ++i) worst = std::max(worst, double(std::abs(out[i].x - s.depth[i].x)));
-  return worst;
-}
-
-TEST(PlaneFitFilter, ConstantDepthIsAFixedPoint) {
-  for (bool disk : {false, true}) {
-    const DepthScene s = flatScene(64, 48, [](int, int) { return 5.0f; }, disk);
-    for (float strength : {4.0f, 50.0f}) {
-      const auto out = smoothOnCpu(s, planeFit(strength, 10));
-      for (std::size_t i = 0; i < out.size(); ++i) ASSERT_EQ(out[i].y, s.depth[i].y) << i;
-      // up to float rounding of the eye-space positions (an ulp of 5 is 4.8e-7)
-      EXPECT_LT(worstDifference(out, s), 5e-6) << "disk " << disk << " strength " << strength;
-    }
-  }
-}
 
 TEST(PlaneFitFilter, TiltedPlaneInEyeSpaceIsAFixedPoint) {
   // The plane n . X = n . (0, 0, -4) through the point 4 units ahead, tilted by about 17 and
   // 11 degrees: its exact linear depth along every pixel's ray, edges and disk rim included.
   const glm::vec3 n = glm::normalize(glm::vec3(0.3f, -0.2f, 1.0f));
+  const ScreenFrame frame = testing::testFrame(96, 72);
   for (bool disk : {false, true}) {
-    const DepthScene probe = flatScene(96, 72, [](int, int) { return 1.0f; }, disk);
-    const DepthScene s = flatScene(
+    const DepthScene s = testing::flatScene(
         96, 72,
         [&](int x, int y) {
-          const glm::vec3 v = pixelRay(probe.frame, x, y);
+          const glm::vec3 v = testing::pixelRay(frame, x, y);
           return 4.0f * n.z * v.z / glm::dot(n, v);
         },
         disk);
     for (float strength : {4.0f, 50.0f}) {
-      const auto out = smoothOnCpu(s, planeFit(strength, 10));
-      EXPECT_LT(worstDifference(out, s), 1e-5) << "disk " << disk << " strength " << strength;
+      const auto out = testing::smoothOnCpu(s, testing::filterOptions("plane-fit", strength, 10));
+      EXPECT_LT(testing::worstChange(out, s), 1e-5) << "disk " << disk << " strength " << strength;
     }
   }
-}
-
-TEST(PlaneFitFilter, BackgroundPixelsAreNeverWritten) {
-  const DepthScene s = sphereScene(96, 72, 1.0f, 3.0f, 0.8f);
-  const auto out = smoothOnCpu(s, planeFit(50.0f, 10));
-  int background = 0;
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    EXPECT_EQ(out[i].y, s.depth[i].y);
-    if (s.depth[i].y < 0.5f) {
-      ++background;
-      ASSERT_EQ(out[i].x, kBackgroundDepth) << i;
-    }
-  }
-  EXPECT_GT(background, 1000);
-}
-
-TEST(PlaneFitFilter, RoughSphereGetsSmootherAndCloserToTheExactDepth) {
-  // 160 x 120: a sphere of about 90 pixels across, bumps of one particle radius (~1.1 pixels).
-  const DepthScene s = sphereScene(160, 120, 1.0f);
-  const auto out = smoothOnCpu(s, planeFit());
-  const double before = roughness(s.depth, s), after = roughness(out, s);
-  const double errorBefore = errorToExact(s.depth, s), errorAfter = errorToExact(out, s);
-  EXPECT_LT(after, before * 0.3);
-  EXPECT_LT(errorAfter, errorBefore * 0.7);
-}
-
-TEST(PlaneFitFilter, MoreIterationsAndLargerWindowsSmoothMore) {
-  // A plane facing the camera at depth 3, roughened by one particle radius with features of
-  // two pixels (a particle radius is 0.66 pixels there).
-  const DepthScene s =
-      flatScene(96, 72, [](int x, int y) { return 3.0f - 0.02f * testing::bumps(x, y, 2.0f, 3); }, false);
-  DepthScene flat = s;
-  flat.exactDepth.assign(s.depth.size(), 3.0f);
-  double previous = roughness(s.depth, flat);
-  for (int iterations : {1, 2, 3, 5, 10}) {
-    const double r = roughness(smoothOnCpu(s, planeFit(4.0f, iterations)), flat);
-    EXPECT_LT(r, previous * 0.9) << iterations << " iterations";
-    previous = r;
-  }
-  previous = roughness(s.depth, flat);
-  for (float strength : {1.0f, 2.0f, 4.0f, 8.0f}) {
-    const double r = roughness(smoothOnCpu(s, planeFit(strength, 3)), flat);
-    EXPECT_LT(r, previous * 0.9) << "strength " << strength;
-    previous = r;
-  }
-}
-
-TEST(PlaneFitFilter, StableAtTheDefaultAndTheLargestSettings) {
-  const SurfaceFilterInfo* info = nullptr;
-  for (const SurfaceFilterInfo& i : surfaceFilters())
-    if (i.name == "plane-fit") info = &i;
-  ASSERT_NE(info, nullptr);
-  // A rough sphere in front of a rough plane: silhouettes, steep rims and pixel-sized noise.
-  const DepthScene s = sphereScene(128, 72, 2.0f, 3.0f, 0.8f, 5.0f);
-  float lo = std::numeric_limits<float>::max(), hi = 0;
-  for (const glm::vec4& d : s.depth)
-    if (d.y > 0.5f) lo = std::min(lo, d.x), hi = std::max(hi, d.x);
-  const double rough = roughness(s.depth, s);
-  for (const SmoothingOptions& options : {planeFit(), planeFit(info->maxStrength, info->maxIterations)}) {
-    const auto out = smoothOnCpu(s, options);
-    float outLo = std::numeric_limits<float>::max(), outHi = 0;
-    for (std::size_t i = 0; i < out.size(); ++i) {
-      ASSERT_TRUE(std::isfinite(out[i].x)) << i;
-      if (s.depth[i].y < 0.5f) continue;
-      outLo = std::min(outLo, out[i].x), outHi = std::max(outHi, out[i].x);
-    }
-    EXPECT_GE(outLo, lo - 0.01f) << options.iterations;
-    EXPECT_LE(outHi, hi + 0.01f) << options.iterations;
-    EXPECT_LT(roughness(out, s), rough * 0.5) << options.iterations;
-  }
-}
-
-TEST(PlaneFitFilter, DepthStepBetweenTwoSurfacesSurvives) {
-  // Two noisy planes, at depth 3 (left) and 3.5 (right): 25 particle radii apart.
-  DepthScene s = flatScene(96, 72, [](int x, int) { return x < 48 ? 3.0f : 3.5f; }, false);
-  for (int y = 0; y < 72; ++y)
-    for (int x = 0; x < 96; ++x) s.depth[y * 96 + x].x -= 0.02f * testing::bumps(x, y, 3.0f, 7);
-  const auto out = smoothOnCpu(s, planeFit(8.0f, 10));
-  for (int y = 0; y < 72; ++y) EXPECT_GT(out[y * 96 + 48].x - out[y * 96 + 47].x, 0.45f) << "row " << y;
-}
-
-TEST(PlaneFitFilter, OptionsDefaultsAndRanges) {
-  const SmoothingOptions defaults = resolve({"plane-fit"});
-  EXPECT_EQ(defaults.iterations, 2);
-  EXPECT_EQ(defaults.strength, 2.0f);
-  EXPECT_NO_THROW(resolve(planeFit(50.0f, 50)));
-  EXPECT_THROW(resolve(planeFit(-1, 51)), InputError);
-  EXPECT_THROW(resolve(planeFit(51.0f)), InputError);
 }
 
 }  // namespace

@@ -30,11 +30,7 @@ TEST_P(SurfaceFilterGl, GpuMatchesTheCpuReference) {
   std::vector<glm::vec4> gpu;
   {
     GpuScreenDevice device("test");
-    device.setFrame(scene.frame);
-    const ScreenImage in = device.createFrameImage(), out = device.createFrameImage();
-    device.upload(in, scene.depth);
-    createSurfaceFilter(options)->apply(device, in, out);
-    gpu = device.download(out);
+    gpu = testing::smoothOn(device, scene, options);
   }
   ASSERT_EQ(gpu.size(), cpu.size());
   double worst = 0;
@@ -46,19 +42,8 @@ TEST_P(SurfaceFilterGl, GpuMatchesTheCpuReference) {
   EXPECT_LT(worst, 2e-3) << GetParam();
 }
 
-std::vector<std::string> filterNames() {
-  std::vector<std::string> names;
-  for (const SurfaceFilterInfo& info : surfaceFilters()) names.emplace_back(info.name);
-  return names;
-}
-
-INSTANTIATE_TEST_SUITE_P(AllFilters, SurfaceFilterGl, ::testing::ValuesIn(filterNames()),
-                         [](const auto& info) {
-                           std::string name = info.param;
-                           for (char& c : name)
-                             if (c == '-') c = '_';
-                           return name;
-                         });
+INSTANTIATE_TEST_SUITE_P(AllFilters, SurfaceFilterGl, ::testing::ValuesIn(testing::surfaceFilterNameList()),
+                         [](const auto& info) { return testing::filterTestName(info.param); });
 
 }  // namespace
 }  // namespace flipscope

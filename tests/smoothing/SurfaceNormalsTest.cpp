@@ -18,15 +18,20 @@ struct AngleError {
   double p95Degrees = 0;
 };
 
-/// Angles between reconstructed and analytic normals over the sphere's pixels that face the
-/// camera (view angle below 70 degrees, away from the silhouette).
-AngleError normalError(const DepthScene& scene, const std::vector<glm::vec4>& depth) {
+/// The normals reconstructed from `depth` (the scene's frame) on the CPU reference.
+std::vector<glm::vec4> normalsOnCpu(const DepthScene& scene, const std::vector<glm::vec4>& depth) {
   CpuScreenDevice device;
   device.setFrame(scene.frame);
   const ScreenImage in = device.createFrameImage(), out = device.createFrameImage();
   device.upload(in, depth);
   reconstructNormals(device, in, out);
-  const auto normals = device.download(out);
+  return device.download(out);
+}
+
+/// Angles between reconstructed and analytic normals over the sphere's pixels that face the
+/// camera (view angle below 70 degrees, away from the silhouette).
+AngleError normalError(const DepthScene& scene, const std::vector<glm::vec4>& depth) {
+  const auto normals = normalsOnCpu(scene, depth);
   std::vector<double> angles;
   for (int y = 0; y < int(scene.frame.size.y); ++y)
     for (int x = 0; x < int(scene.frame.size.x); ++x) {
@@ -55,12 +60,7 @@ TEST(SurfaceNormals, ExactSphereDepthGivesTheAnalyticNormals) {
 
 TEST(SurfaceNormals, NormalsFaceTheCameraAndIgnoreTheBackground) {
   const DepthScene scene = testing::sphereScene(64, 48, 0.0f, 3.0f, 0.8f, 6.0f);
-  CpuScreenDevice device;
-  device.setFrame(scene.frame);
-  const ScreenImage in = device.createFrameImage(), out = device.createFrameImage();
-  device.upload(in, scene.depth);
-  reconstructNormals(device, in, out);
-  const auto normals = device.download(out);
+  const auto normals = normalsOnCpu(scene, scene.depth);
   for (int y = 0; y < 48; ++y)
     for (int x = 0; x < 64; ++x) {
       const glm::vec4 n = normals[y * 64 + x];
@@ -95,18 +95,8 @@ TEST_P(FilteredSphereNormals, ComeCloseToTheAnalyticNormals) {
   EXPECT_LT(smooth.p95Degrees, 30.0) << GetParam();
 }
 
-std::vector<std::string> filterNames() {
-  std::vector<std::string> names;
-  for (const SurfaceFilterInfo& info : surfaceFilters()) names.emplace_back(info.name);
-  return names;
-}
-
-INSTANTIATE_TEST_SUITE_P(AllFilters, FilteredSphereNormals, ::testing::ValuesIn(filterNames()),
-                         [](const auto& info) {
-                           std::string name = info.param;
-                           std::replace(name.begin(), name.end(), '-', '_');
-                           return name;
-                         });
+INSTANTIATE_TEST_SUITE_P(AllFilters, FilteredSphereNormals, ::testing::ValuesIn(testing::surfaceFilterNameList()),
+                         [](const auto& info) { return testing::filterTestName(info.param); });
 
 }  // namespace
 }  // namespace flipscope
