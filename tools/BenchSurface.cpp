@@ -12,10 +12,10 @@
 // camera, seen obliquely), sampled by uniformly random points on both surfaces, one particle per
 // cell^2 of surface, binned by the real preprocess (convertFrame) into a store in --work-dir and
 // rendered through FramePipeline with each --smoothing filter (sphere radius: the default for a
-// store whose particle spacing is one cell). Per pixel, the camera ray (Camera::pixelRay) is
-// intersected with the analytic surface offset towards the camera by the sphere radius r (a
-// sphere of radius R + r and the plane moved by r: the envelope of spheres centred on the
-// surface). Measured pixels: the ray meets the offset surface, no pixel within 3 px (a 7x7
+// store whose particle spacing is one cell; the shaded images go to --work-dir too). Per pixel,
+// the camera ray (Camera::pixelRay) is intersected with the analytic surface offset towards the
+// camera by the sphere radius r (a sphere of radius R + r and the plane moved by r: the envelope
+// of spheres centred on the surface). Measured pixels: the ray meets the offset surface, no pixel within 3 px (a 7x7
 // window) meets a different surface or none (no analytic depth discontinuity near it), and the
 // pipeline's image has a hit there. Over them:
 //   normal error: angle in degrees between FrameOutput's image.normal (the normals reconstructed
@@ -34,8 +34,8 @@
 #include <filesystem>
 #include <limits>
 #include <map>
-#include <numbers>
 #include <memory>
+#include <numbers>
 #include <optional>
 #include <random>
 #include <string>
@@ -68,7 +68,7 @@ using Json = nlohmann::ordered_json;
 
 double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
-constexpr double kCellSize = 0.01;   // world units (not 1, so that a unit slip shows)
+constexpr double kCellSize = 0.01;    // world units (not 1, so that a unit slip shows)
 constexpr int kSilhouettePixels = 3;  // measured pixels lie this far from an analytic depth discontinuity
 // Reichl et al. 2014 Fig. 10: smoothing at 1280x720 on a GTX Titan.
 constexpr double kPaperBilateralMs = 15.0;
@@ -139,12 +139,13 @@ struct AnalyticScene {
     std::vector<glm::vec3> points;
     points.reserve(sphereParticles + planeParticles);
     for (std::uint64_t i = 0; i < sphereParticles; ++i) {
-      const double z = 2 * unit(rng) - 1, phi = 2 * std::numbers::pi * unit(rng), s = std::sqrt(std::max(0.0, 1 - z * z));
+      const double z = 2 * unit(rng) - 1, phi = 2 * std::numbers::pi * unit(rng),
+                   s = std::sqrt(std::max(0.0, 1 - z * z));
       points.push_back(glm::vec3(centre + radius * glm::dvec3(s * std::cos(phi), s * std::sin(phi), z)));
     }
     for (std::uint64_t i = 0; i < planeParticles; ++i)
-      points.push_back(glm::vec3(glm::mix(planeMin.x, planeMax.x, unit(rng)), glm::mix(planeMin.y, planeMax.y, unit(rng)),
-                                 planeZ));
+      points.push_back(
+          glm::vec3(glm::mix(planeMin.x, planeMax.x, unit(rng)), glm::mix(planeMin.y, planeMax.y, unit(rng)), planeZ));
     return points;
   }
 
@@ -313,7 +314,9 @@ std::map<std::string, StageMs> timeStages(ScreenDevice& device, const ScreenFram
 
   std::map<std::string, StageMs> result;
   for (const SurfaceFilterInfo& info : surfaceFilters()) {
-    if (!quiet) std::fprintf(stderr, "bench surface: timing %s on %s ...\n", std::string(info.name).c_str(), device.name().c_str());
+    if (!quiet)
+      std::fprintf(stderr, "bench surface: timing %s on %s ...\n", std::string(info.name).c_str(),
+                   device.name().c_str());
     auto filter = createSurfaceFilter(SmoothingOptions{.name = std::string(info.name)});
     auto timed = [&](auto&& work) {
       const auto start = Clock::now();
@@ -418,6 +421,7 @@ void runBenchSurface(const BenchSurfaceArgs& a) {
     FramePipeline pipeline(BrickStore::open(storeDir), qualityDevice, settings, surface);
     const FrameOutput out = pipeline.render(0, camera);
     quality[name] = measure(out.image, analytic, header.cellSize);
+    writeImage(work / ("surface_" + name + ".png"), out.image);
     if (qualityName.empty()) {
       qualityName = pipeline.deviceName();
       frame = pipeline.screenFrame(camera);
@@ -490,26 +494,31 @@ void runBenchSurface(const BenchSurfaceArgs& a) {
       }
       j["filters"][name] = f;
     }
-    j["paper"] = {{"source", "Reichl et al. 2014 Fig. 10"}, {"gpu", "GTX Titan"}, {"width", 1280},
-                  {"height", 720},  {"bilateral_ms", kPaperBilateralMs},    {"rof_ms", kPaperRofMs},
+    j["paper"] = {{"source", "Reichl et al. 2014 Fig. 10"},
+                  {"gpu", "GTX Titan"},
+                  {"width", 1280},
+                  {"height", 720},
+                  {"bilateral_ms", kPaperBilateralMs},
+                  {"rof_ms", kPaperRofMs},
                   {"rof_iterations", kPaperRofIterations}};
     std::printf("%s\n", j.dump(2).c_str());
     return;
   }
 
-  std::printf("bench surface: %ux%u, a sphere (R = %.1f cells) before a plane, %s particles (%s on the sphere), "
-              "1 per cell^2 of surface; particle radius %.2f cells, jitter %.2f\n",
-              width, height, scene.radius / kCellSize, Progress::humanCount(double(particles)).c_str(),
-              Progress::humanCount(double(scene.sphereParticles)).c_str(), settings.radius, settings.jitter);
+  std::printf(
+      "bench surface: %ux%u, a sphere (R = %.1f cells) before a plane, %s particles (%s on the sphere), "
+      "1 per cell^2 of surface; particle radius %.2f cells, jitter %.2f\n",
+      width, height, scene.radius / kCellSize, Progress::humanCount(double(particles)).c_str(),
+      Progress::humanCount(double(scene.sphereParticles)).c_str(), settings.radius, settings.jitter);
   for (const DeviceResult& d : devices) std::printf("  %-3s = %s\n", d.key.c_str(), d.name.c_str());
   if (!glSkipped.empty()) std::printf("  gl skipped: %s\n", glSkipped.c_str());
-  std::printf("times: median of %d runs after one warm-up, ms; quality: %s pipeline over %zu pixels (%.0f%% of the "
-              "image, >= %d px from silhouettes)\n\n",
-              a.repeats, qualityName.c_str(), analytic.measuredCount, 100.0 * coverage, kSilhouettePixels);
+  std::printf(
+      "times: median of %d runs after one warm-up, ms; quality: %s pipeline over %zu pixels (%.0f%% of the "
+      "image, >= %d px from silhouettes)\n\n",
+      a.repeats, qualityName.c_str(), analytic.measuredCount, 100.0 * coverage, kSilhouettePixels);
 
   std::printf("%-15s %5s", "filter", "iters");
-  for (const DeviceResult& d : devices)
-    std::printf(" | %3s smooth %8s %8s", d.key.c_str(), "normals", "shading");
+  for (const DeviceResult& d : devices) std::printf(" | %3s smooth %8s %8s", d.key.c_str(), "normals", "shading");
   std::printf(" | %-12s | %-15s %5s | %-10s %6s\n", "paper smooth", "normal err deg", "p95", "depth cells", "bias");
   for (const SurfaceFilterInfo& info : surfaceFilters()) {
     const std::string name(info.name);
@@ -527,16 +536,18 @@ void runBenchSurface(const BenchSurfaceArgs& a) {
     std::printf(" | %15.2f %5.1f | %11.2f %+6.2f\n", q.normalMeanDeg, q.normalP95Deg, q.depthErrorCells,
                 q.depthBiasCells);
   }
-  std::printf("\npaper (Reichl et al. 2014 Fig. 10, GTX Titan, 1280x720): bilateral %.0f ms, ROF %d iterations %.0f "
-              "ms\n",
-              kPaperBilateralMs, kPaperRofIterations, kPaperRofMs);
+  std::printf(
+      "\npaper (Reichl et al. 2014 Fig. 10, GTX Titan, 1280x720): bilateral %.0f ms, ROF %d iterations %.0f "
+      "ms\n",
+      kPaperBilateralMs, kPaperRofIterations, kPaperRofMs);
   if (!rofDevice.empty())
     std::printf("here: ROF %d iterations %.1f ms on %s at %ux%u (%.1fx the paper's time%s)\n",
                 resolved["rof"].iterations, rofMs, rofDevice.c_str(), width, height, rofMs / kPaperRofMs,
                 paperSize ? "" : "; not the paper's image size");
-  std::printf("normal error: angle to the analytic normal; depth error: |smoothed depth - analytic depth of the "
-              "surface offset by the particle radius| in cells (bias: signed mean, + = behind)\n");
-  std::printf("store in %s\n", storeDir.c_str());
+  std::printf(
+      "normal error: angle to the analytic normal; depth error: |smoothed depth - analytic depth of the "
+      "surface offset by the particle radius| in cells (bias: signed mean, + = behind)\n");
+  std::printf("store and images (surface_<filter>.png) in %s\n", work.c_str());
 }
 
 }  // namespace
@@ -544,7 +555,8 @@ void runBenchSurface(const BenchSurfaceArgs& a) {
 void addBenchSurfaceCommand(CLI::App& bench) {
   auto args = std::make_shared<BenchSurfaceArgs>();
   auto* cmd = bench.add_subcommand(
-      "surface", "Smoothing, normals and shading times per filter and device; each filter's error on an analytic scene");
+      "surface",
+      "Smoothing, normals and shading times per filter and device; each filter's error on an analytic scene");
   cmd->add_option("--size", args->size, "Image size WxH")->capture_default_str();
   cmd->add_option("--repeats", args->repeats, "Timed runs per stage (the median is reported), after one warm-up")
       ->check(CLI::Range(1, 1000))

@@ -12,8 +12,8 @@ namespace {
 TEST(BenchSurface, JsonHasEveryFilterAndRofBeatsTheUnsmoothedNormals) {
   flipscope::testing::TempDir dir("bench-surface");
   const flipscope::testing::CommandRun run = flipscope::testing::runFlipscope(
-      "bench surface --size 128x72 --repeats 1 --device cpu --particles 20k --json --work-dir '" +
-      dir.path().string() + "'");
+      "bench surface --size 128x72 --repeats 1 --device cpu --particles 20k --json --work-dir '" + dir.path().string() +
+      "'");
   ASSERT_EQ(run.exitCode, 0) << run.output;
   const auto j = nlohmann::json::parse(run.output);
   EXPECT_GT(j["rof_ms"].get<double>(), 0.0) << run.output;
