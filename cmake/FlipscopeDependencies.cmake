@@ -10,6 +10,8 @@ find_package(OpenEXR 3.1 REQUIRED)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash>=0.8)
 pkg_check_modules(EPOXY REQUIRED IMPORTED_TARGET epoxy>=1.5)
+# Blosc 1.21 (an OpenVDB dependency): our VDB reader decompresses with it (blosc_cbuffer_validate).
+pkg_check_modules(BLOSC REQUIRED IMPORTED_TARGET blosc>=1.21)
 
 # OpenVDB 10 ships a Find module, not a config package.
 find_path(_flipscope_openvdb_cmake FindOpenVDB.cmake

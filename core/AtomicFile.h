@@ -1,17 +1,85 @@
 // AtomicFile: write a file under a temporary name, then fsync and rename it into place, so a
 // reader never sees a half-written file: after a crash the destination holds either the old
 // content or the new, complete one. An AtomicFile destroyed without commit() removes its
-// temporary file. Not thread safe.
+// temporary file, and so does SIGINT, SIGTERM or SIGHUP once installCleanupSignalHandlers()
+// ran (the temporary is registered with CleanupOnSignal). Not thread safe.
+//
+// A temporary is named `.<name>.tmp-<pid>-<n>`: the PID tells a later process whether the
+// writer is gone (temporaryFileOwner, processExists), so that a temporary left by a killed
+// process (SIGKILL, power loss) can be recognised as stale and removed.
 #pragma once
+
+#include <signal.h>
 
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <span>
+#include <string_view>
 #include <vector>
 
 namespace flipscope {
+
+/// Registers a path to remove when the process is stopped by SIGINT, SIGTERM or SIGHUP, for as
+/// long as the object lives (or until release()). Destroying it does not remove the path.
+/// installCleanupSignalHandlers() makes those signals unlink every registered file, then rmdir
+/// every registered directory (only an empty one goes), then end the process by the same
+/// signal with its default action. The handler is async-signal-safe: it uses atomics and calls
+/// unlink, rmdir, nanosleep and raise only. Registration is thread safe; at most kCleanupSlots paths are
+/// registered at once, beyond that a registration does nothing (registered() is false).
+class CleanupOnSignal {
+ public:
+  enum class Kind { File, Directory };
+  static constexpr int kCleanupSlots = 4096;
+
+  CleanupOnSignal() = default;
+  explicit CleanupOnSignal(const std::filesystem::path& path, Kind kind = Kind::File);
+  ~CleanupOnSignal() { release(); }
+  CleanupOnSignal(CleanupOnSignal&& other) noexcept : mSlot(other.mSlot) { other.mSlot = -1; }
+  CleanupOnSignal& operator=(CleanupOnSignal&& other) noexcept;
+  CleanupOnSignal(const CleanupOnSignal&) = delete;
+  CleanupOnSignal& operator=(const CleanupOnSignal&) = delete;
+
+  /// Forgets the path: a later signal leaves it alone.
+  void release() noexcept;
+  bool registered() const { return mSlot >= 0; }
+
+ private:
+  int mSlot = -1;
+};
+
+/// One step, for the signal handler, of creating or renaming files and changing their
+/// CleanupOnSignal registrations (register then create a temporary; rename store.fsh to list a
+/// frame, then stop the frame file's registration): while one lives, the cleanup signals are
+/// blocked in this thread (delivered when it ends), and a handler running on another thread
+/// waits for it to end (up to 5 s) before it removes anything. So the handler never sees a file
+/// created but not yet registered, nor removes one just committed. The outermost step opened
+/// after a handler started never returns (the process is ending). Nestable.
+class DeferCleanupSignals {
+ public:
+  DeferCleanupSignals();
+  ~DeferCleanupSignals();
+  DeferCleanupSignals(const DeferCleanupSignals&) = delete;
+  DeferCleanupSignals& operator=(const DeferCleanupSignals&) = delete;
+
+ private:
+  sigset_t mSavedMask;
+};
+
+/// Installs the SIGINT, SIGTERM and SIGHUP handlers of CleanupOnSignal (idempotent). The
+/// signals end the process as before, with the registered paths removed first; a signal the
+/// process ignores (nohup) stays ignored.
+void installCleanupSignalHandlers();
+
+/// The PID in the name of an AtomicFile temporary (`.<name>.tmp-<pid>-<n>`); nullopt when
+/// `fileName` (a name, not a path) is not one.
+std::optional<long> temporaryFileOwner(std::string_view fileName);
+
+/// False only when there is no process `pid` (kill(pid, 0) fails with ESRCH). A PID reused by
+/// an unrelated process counts as existing, so a stale file then stays until that one ends.
+bool processExists(long pid);
 
 class AtomicFile {
  public:
@@ -37,6 +105,7 @@ class AtomicFile {
  private:
   std::filesystem::path mDestination;
   std::filesystem::path mTemporary;
+  CleanupOnSignal mCleanup;  ///< the temporary, until committed or removed
   std::FILE* mFile = nullptr;
   std::uint64_t mOffset = 0;
 };

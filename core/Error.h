@@ -25,12 +25,31 @@ class InputError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// `text` with NUL and the other control bytes (but line breaks and tabs) written as \xNN, so
+/// that a message quoting bytes of a file is printed whole (C strings end at a NUL).
+inline std::string printableText(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if ((byte < 0x20 && c != '\n' && c != '\t') || byte == 0x7f) {
+      static constexpr char kHex[] = "0123456789abcdef";
+      out += "\\x";
+      out += kHex[byte >> 4];
+      out += kHex[byte & 15];
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
 /// A file that cannot be read or written, or whose content is malformed.
-/// what() reads "<path>: <reason>".
+/// what() reads "<path>: <reason>", the reason made printable (printableText).
 class FileError : public InputError {
  public:
   FileError(const std::filesystem::path& path, const std::string& reason)
-      : InputError(path.string() + ": " + reason), mPath(path) {}
+      : InputError(path.string() + ": " + printableText(reason)), mPath(path) {}
   const std::filesystem::path& path() const { return mPath; }
 
  private:

@@ -46,22 +46,67 @@ std::vector<std::byte> encodeBrick(const DecodedBrick& brick, int zstdLevel) {
   return out;
 }
 
-DecodedBrick decodeBrick(std::span<const std::byte> payload, const std::filesystem::path& file, std::uint32_t brickIndex,
-                         const BrickRecord& expected, std::uint32_t cellsPerBrick, bool hasAttribute) {
+namespace {
+
+/// Payloads that claim more than this (and more than 64 times their size) are decompressed as a
+/// stream into a buffer that grows with what the frame really holds, so that a payload that
+/// declares more than it holds cannot make us allocate what it declares.
+constexpr std::uint64_t kOneShotBytes = 4 << 20;
+
+template <class Fail>
+std::vector<std::byte> decompressStreamed(std::span<const std::byte> payload, std::uint64_t declared,
+                                          const Fail& fail) {
+  thread_local ZSTD_DCtx* context = ZSTD_createDCtx();
+  ZSTD_DCtx_reset(context, ZSTD_reset_session_only);
+  std::vector<std::byte> raw;
+  std::size_t produced = 0;
+  ZSTD_inBuffer input{payload.data(), payload.size(), 0};
+  for (std::size_t hint = 1; hint != 0;) {
+    if (produced == raw.size() && raw.size() < declared)
+      raw.resize(
+          std::size_t(std::min<std::uint64_t>(declared, std::max<std::uint64_t>(2 * raw.size(), kOneShotBytes))));
+    std::byte spare;  // room for zstd to finish the frame, and to show content beyond the declared size
+    const bool full = produced == raw.size();
+    ZSTD_outBuffer out{full ? &spare : raw.data() + produced, full ? 1 : raw.size() - produced, 0};
+    const std::size_t consumed = input.pos;
+    hint = ZSTD_decompressStream(context, &out, &input);
+    if (ZSTD_isError(hint)) throw fail(std::string("zstd: ") + ZSTD_getErrorName(hint));
+    if (full && out.pos) throw fail("payload holds more than the " + std::to_string(declared) + " bytes it declares");
+    if (!full) produced += out.pos;
+    if (hint != 0 && out.pos == 0 && input.pos == consumed) throw fail("payload ends inside its zstd frame");
+  }
+  if (produced != declared) throw fail("payload decompressed to fewer bytes than declared");
+  if (input.pos != input.size) throw fail("bytes after the payload's zstd frame");
+  return raw;
+}
+
+}  // namespace
+
+DecodedBrick decodeBrick(std::span<const std::byte> payload, const std::filesystem::path& file,
+                         std::uint32_t brickIndex, const BrickRecord& expected, std::uint32_t cellsPerBrick,
+                         bool hasAttribute) {
   const std::string where = "brick " + std::to_string(brickIndex);
   auto fail = [&](const std::string& reason) -> FileError { return FileError(file, where + ": " + reason); };
 
+  if (expected.cells > cellsPerBrick || expected.particles < expected.cells)
+    throw fail("record claims " + std::to_string(expected.cells) + " cells and " + std::to_string(expected.particles) +
+               " particles in a brick of " + std::to_string(cellsPerBrick) + " cells");
   // Largest valid raw size: a 5-byte varint per gap and count, plus the attributes.
   const std::uint64_t bound = 10 + 10ull * expected.cells + (hasAttribute ? 2ull * expected.particles : 0);
   const unsigned long long declared = ZSTD_getFrameContentSize(payload.data(), payload.size());
   if (declared == ZSTD_CONTENTSIZE_ERROR || declared == ZSTD_CONTENTSIZE_UNKNOWN)
     throw fail("payload is not a zstd frame of known size");
   if (declared > bound) throw fail("payload declares " + std::to_string(declared) + " bytes, more than possible");
-  std::vector<std::byte> raw(declared);
   thread_local ZSTD_DCtx* context = ZSTD_createDCtx();
-  std::size_t n = ZSTD_decompressDCtx(context, raw.data(), raw.size(), payload.data(), payload.size());
-  if (ZSTD_isError(n)) throw fail(std::string("zstd: ") + ZSTD_getErrorName(n));
-  if (n != declared) throw fail("payload decompressed to fewer bytes than declared");
+  std::vector<std::byte> raw;
+  if (declared <= std::max<std::uint64_t>(kOneShotBytes, 64 * std::uint64_t(payload.size()))) {
+    raw.resize(declared);
+    const std::size_t n = ZSTD_decompressDCtx(context, raw.data(), raw.size(), payload.data(), payload.size());
+    if (ZSTD_isError(n)) throw fail(std::string("zstd: ") + ZSTD_getErrorName(n));
+    if (n != declared) throw fail("payload decompressed to fewer bytes than declared");
+  } else {
+    raw = decompressStreamed(payload, declared, fail);
+  }
 
   ByteReader in(raw, file.string() + ", " + where + " (decompressed)");
   DecodedBrick brick;
@@ -72,15 +117,17 @@ DecodedBrick decodeBrick(std::span<const std::byte> payload, const std::filesyst
   brick.counts.resize(occupied);
   std::uint64_t cell = 0;
   for (std::uint64_t i = 0; i < occupied; ++i) {
-    std::uint64_t gap = in.getVarint("cell gap");
-    cell = i == 0 ? gap : cell + 1 + gap;
+    const std::uint64_t gap = in.getVarint("cell gap");
+    if (gap >= cellsPerBrick) throw fail("cell gap " + std::to_string(gap) + " is larger than the brick");
+    cell = i == 0 ? gap : cell + 1 + gap;  // no wrap-around: both terms are below cellsPerBrick
     if (cell >= cellsPerBrick) throw fail("cell index " + std::to_string(cell) + " outside the brick");
     brick.cells[i] = std::uint32_t(cell);
   }
   std::uint64_t particles = 0;
   for (std::uint64_t i = 0; i < occupied; ++i) {
-    std::uint64_t count = in.getVarint("cell count") + 1;
-    if (count > expected.particles) throw fail("cell count larger than the brick's particle count");
+    const std::uint64_t countMinus1 = in.getVarint("cell count");
+    if (countMinus1 >= expected.particles) throw fail("cell count larger than the brick's particle count");
+    const std::uint64_t count = countMinus1 + 1;
     brick.counts[i] = std::uint32_t(count);
     particles += count;
   }

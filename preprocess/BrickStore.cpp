@@ -2,6 +2,7 @@
 #include "preprocess/BrickStore.h"
 
 #include <fcntl.h>
+#include <sys/random.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include <cmath>
 #include <cstring>
 #include <mutex>
+#include <random>
 #include <set>
 
 #include "core/Bytes.h"
@@ -20,25 +22,32 @@ namespace flipscope {
 namespace {
 
 constexpr char kStoreMagic[8] = {'F', 'S', 'S', 'T', 'O', 'R', 'E', '1'};
-constexpr std::size_t kStoreHeaderBytes = 8 + 4 + 4 + 8 + 24 + 12 + 4 + 8 + 8;
+/// Fixed part of store.fsh: magic .. particle spacing, store id, run count; then 8 bytes a run
+/// of the frame table, then the checksum.
+constexpr std::size_t kStoreHeaderFixedBytes = 8 + 4 + 4 + 8 + 24 + 12 + 4 + 8 + 16 + 4;
+/// The footer's version field, counted back from the end of the file.
+constexpr std::uint64_t kFooterVersionFromEnd = 24;
 
 bool isValidBrickSize(std::uint32_t b) { return b == 32 || b == 64 || b == 128; }
 
-std::string frameFileName(int frame) {
-  char name[32];
-  std::snprintf(name, sizeof name, "frame_%06d.fsf", frame);
-  return name;
+/// Consecutive frames first .. first + count - 1.
+struct FrameRun {
+  std::int32_t first;
+  std::uint32_t count;
+};
+
+std::vector<FrameRun> runsOf(const std::vector<int>& frames) {
+  std::vector<FrameRun> runs;
+  for (int f : frames) {
+    if (!runs.empty() && std::int64_t(runs.back().first) + runs.back().count == f)
+      ++runs.back().count;
+    else
+      runs.push_back({f, 1});
+  }
+  return runs;
 }
 
-std::optional<int> frameFromFileName(const std::string& name) {
-  if (name.size() != 16 || name.rfind("frame_", 0) != 0 || name.substr(12) != ".fsf") return std::nullopt;
-  int frame = 0;
-  for (char c : name.substr(6, 6)) {
-    if (c < '0' || c > '9') return std::nullopt;
-    frame = frame * 10 + (c - '0');
-  }
-  return frame;
-}
+std::vector<int> serializeList(const std::set<int>& frames) { return {frames.begin(), frames.end()}; }
 
 /// pread exactly `n` bytes at `offset`; FileError naming `what` when the file is shorter.
 void readAt(int fd, const std::filesystem::path& file, std::uint64_t offset, void* out, std::size_t n, const char* what) {
@@ -80,6 +89,7 @@ void serializeFooter(ByteWriter& w, const FrameFooter& f) {
   w.put(f.stats.skippedOutside);
   w.put(f.stats.attributeMin);
   w.put(f.stats.attributeMax);
+  w.append(f.storeId.data(), f.storeId.size());
   w.put(f.version);
   w.put(f.reserved);
 }
@@ -97,6 +107,8 @@ FrameFooter parseFooter(ByteReader& r) {
   f.stats.skippedOutside = r.get<std::uint64_t>("footer skipped outside");
   f.stats.attributeMin = r.get<float>("footer attribute min");
   f.stats.attributeMax = r.get<float>("footer attribute max");
+  auto id = r.getBytes(f.storeId.size(), "footer store id");
+  std::memcpy(f.storeId.data(), id.data(), f.storeId.size());
   f.version = r.get<std::uint32_t>("footer version");
   f.reserved = r.get<std::uint32_t>("footer reserved");
   f.indexChecksum = r.get<std::uint64_t>("footer checksum");
@@ -124,9 +136,52 @@ const char* attributeName(AttributeKind kind) {
   return "unknown";
 }
 
+std::string frameFileName(int frame) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%06d.fsf", frame);
+  return name;
+}
+
+std::optional<int> frameFromFileName(const std::string& name) {
+  if (name.size() != 16 || name.rfind("frame_", 0) != 0 || name.substr(12) != ".fsf") return std::nullopt;
+  int frame = 0;
+  for (char c : name.substr(6, 6)) {
+    if (c < '0' || c > '9') return std::nullopt;
+    frame = frame * 10 + (c - '0');
+  }
+  return frame;
+}
+
+StoreId randomStoreId() {
+  StoreId id{};
+  std::size_t filled = 0;
+  while (filled < id.size()) {
+    const ssize_t got = ::getrandom(id.data() + filled, id.size() - filled, 0);
+    if (got < 0 && errno == EINTR) continue;
+    if (got <= 0) break;
+    filled += std::size_t(got);
+  }
+  if (filled < id.size()) {  // no getrandom (old kernel, seccomp): the C++ library's source
+    std::random_device device;
+    for (auto& byte : id) byte = std::uint8_t(device());
+  }
+  if (id == StoreId{}) id[0] = 1;  // all zero means "no id"
+  return id;
+}
+
+std::string storeIdText(const StoreId& id) {
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string text;
+  for (auto byte : id) {
+    text += kHex[byte >> 4];
+    text += kHex[byte & 15];
+  }
+  return text;
+}
+
 // ---- store header ----------------------------------------------------------------------
 
-std::vector<std::byte> serializeStoreHeader(const StoreHeader& h) {
+std::vector<std::byte> serializeStoreHeader(const StoreHeader& h, const std::vector<int>& frames) {
   ByteWriter w;
   w.append(kStoreMagic, sizeof kStoreMagic);
   w.put(h.version);
@@ -140,12 +195,20 @@ std::vector<std::byte> serializeStoreHeader(const StoreHeader& h) {
   w.put(h.brickGrid.z);
   w.put(static_cast<std::uint32_t>(h.attribute));
   w.put(h.particleSpacing);
+  w.append(h.id.data(), h.id.size());
+  const auto runs = runsOf(frames);
+  w.put(std::uint32_t(runs.size()));
+  for (const FrameRun& run : runs) {
+    w.put(run.first);
+    w.put(run.count);
+  }
   w.put(checksum64(w.view()));
-  FLIPSCOPE_CHECK(w.size() == kStoreHeaderBytes, w.size());
+  FLIPSCOPE_CHECK(w.size() == kStoreHeaderFixedBytes + 8 * runs.size() + 8, w.size());
   return std::move(w.bytes());
 }
 
-StoreHeader parseStoreHeader(std::span<const std::byte> bytes, const std::filesystem::path& file) {
+StoreHeader parseStoreHeader(std::span<const std::byte> bytes, const std::filesystem::path& file,
+                             std::vector<int>* frames) {
   ByteReader r(bytes, file);
   auto magic = r.getBytes(8, "magic");
   if (std::memcmp(magic.data(), kStoreMagic, 8) != 0) r.fail("magic", "not a flipscope store header");
@@ -164,6 +227,15 @@ StoreHeader parseStoreHeader(std::span<const std::byte> bytes, const std::filesy
   h.brickGrid.z = r.get<std::uint32_t>("brick grid z");
   auto attribute = r.get<std::uint32_t>("attribute");
   h.particleSpacing = r.get<double>("particle spacing");
+  auto id = r.getBytes(h.id.size(), "store id");
+  std::memcpy(h.id.data(), id.data(), h.id.size());
+  const auto runCount = r.get<std::uint32_t>("frame table runs");
+  if (runCount > r.remaining() / 8) r.fail("frame table runs", "more runs than the file holds");
+  std::vector<FrameRun> runs(runCount);
+  for (auto& run : runs) {
+    run.first = r.get<std::int32_t>("frame run first");
+    run.count = r.get<std::uint32_t>("frame run count");
+  }
   const std::size_t checked = r.position();
   auto stored = r.get<std::uint64_t>("checksum");
   r.expectEnd("end of store header");
@@ -178,6 +250,20 @@ StoreHeader parseStoreHeader(std::span<const std::byte> bytes, const std::filesy
   if (attribute > 1) throw FileError(file, "unknown attribute kind " + std::to_string(attribute));
   if (!(std::isfinite(h.particleSpacing) && h.particleSpacing >= 0)) throw FileError(file, "invalid particle spacing");
   h.attribute = AttributeKind(attribute);
+  // Canonical runs: ascending, separated by a gap, within 0..kMaxFrame.
+  std::int64_t previousEnd = -2;  // one past the last frame of the previous run
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const std::int64_t first = runs[i].first, end = first + std::int64_t(runs[i].count);
+    if (runs[i].count == 0 || first < 0 || end - 1 > kMaxFrame || first <= previousEnd)
+      throw FileError(file, "frame table run " + std::to_string(i) + " (frames " + std::to_string(first) + " to " +
+                                std::to_string(end - 1) + ") is invalid or out of order");
+    previousEnd = end;
+  }
+  if (frames) {
+    frames->clear();
+    for (const FrameRun& run : runs)
+      for (std::uint32_t k = 0; k < run.count; ++k) frames->push_back(run.first + int(k));
+  }
   return h;
 }
 
@@ -219,6 +305,7 @@ FrameIndex FrameWriter::finish(const FrameStats& stats) {
   footer.brickCount = std::uint32_t(index.bricks.size());
   footer.frame = mFrame;
   footer.stats = stats;
+  footer.storeId = mHeader.id;
   footer.octreeOffset = mFile.offset();
   footer.tableOffset = footer.octreeOffset + 8ull * footer.nodeCount;
   ByteWriter w;
@@ -250,10 +337,14 @@ FrameIndex readFrameIndex(const std::filesystem::path& file, const StoreHeader& 
   if (std::memcmp(footerBytes.data() + kFrameFooterBytes - 8, kFooterMagic, 8) != 0)
     throw FileError(file, "no frame footer at byte " + std::to_string(footerOffset) +
                               " (file truncated or corrupted)");
+  // The version first, at the place every version keeps it: an old frame is named as one.
+  std::uint32_t version = 0;
+  std::memcpy(&version, footerBytes.data() + kFrameFooterBytes - kFooterVersionFromEnd, 4);
+  if (version != kStoreVersion)
+    throw FileError(file, "unsupported frame version " + std::to_string(version) + " (this flipscope reads version " +
+                              std::to_string(kStoreVersion) + "); convert the particle files again into a new store");
   ByteReader fr(std::span<const std::byte>(footerBytes).first(kFrameFooterBytes - 8), file, footerOffset);
   FrameFooter footer = parseFooter(fr);
-  if (footer.version != kStoreVersion)
-    throw FileError(file, "unsupported frame version " + std::to_string(footer.version));
   // The index region runs from the octree to the checksum field; check sizes before reading.
   const std::uint64_t nodesBytes = 8ull * footer.nodeCount;
   const std::uint64_t tableBytes = 40ull * footer.brickCount;
@@ -264,6 +355,9 @@ FrameIndex readFrameIndex(const std::filesystem::path& file, const StoreHeader& 
   readAt(handle.fd(), file, footer.octreeOffset, index.data(), index.size(), "octree and brick table");
   if (checksum64(index) != footer.indexChecksum)
     throw FileError(file, "index checksum mismatch: octree, brick table or footer corrupted");
+  if (footer.storeId != header.id)
+    throw FileError(file, "belongs to another store (its store id is " + storeIdText(footer.storeId) +
+                              ", this store's is " + storeIdText(header.id) + "); frames cannot move between stores");
 
   FrameIndex out;
   out.file = file;
@@ -314,7 +408,7 @@ FrameIndex readFrameIndex(const std::filesystem::path& file, const StoreHeader& 
 
 struct BrickStore::Shared {
   std::mutex mutex;
-  std::set<int> frames;
+  std::set<int> frames;  ///< the frame table
   std::map<int, std::shared_ptr<const FrameIndex>> indices;
 };
 
@@ -331,25 +425,29 @@ BrickStore BrickStore::open(const std::filesystem::path& dir) {
     throw FileError(dir, std::string("not a brick store: ") + kStoreHeaderName + " missing");
   BrickStore store;
   store.mDir = dir;
-  store.mHeader = parseStoreHeader(readFile(headerPath), headerPath);
+  std::vector<int> frames;
+  store.mHeader = parseStoreHeader(readFile(headerPath), headerPath, &frames);
   store.mShared = std::make_shared<Shared>();
-  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-    if (auto frame = frameFromFileName(entry.path().filename().string())) store.mShared->frames.insert(*frame);
-  }
+  store.mShared->frames.insert(frames.begin(), frames.end());
   return store;
 }
 
 BrickStore BrickStore::createOrAppend(const std::filesystem::path& dir, const StoreHeader& header) {
   if (exists(dir)) {
     BrickStore store = open(dir);
-    const StoreHeader& h = store.header();
-    if (h.brickSize != header.brickSize || h.cellSize != header.cellSize || h.origin != header.origin ||
-        h.brickGrid != header.brickGrid || h.attribute != header.attribute)
-      throw FileError(dir, "existing store has a different domain, cell size, brick size or attribute");
-    return store;
+    if (!store.incomplete()) {
+      const StoreHeader& h = store.header();
+      if (h.brickSize != header.brickSize || h.cellSize != header.cellSize || h.origin != header.origin ||
+          h.brickGrid != header.brickGrid || h.attribute != header.attribute)
+        throw FileError(dir, "existing store has a different domain, cell size, brick size or attribute");
+      return store;
+    }
   }
+  StoreHeader fresh = header;
+  fresh.version = kStoreVersion;
+  if (fresh.id == StoreId{}) fresh.id = randomStoreId();
   std::filesystem::create_directories(dir);
-  writeFileAtomically(dir / kStoreHeaderName, serializeStoreHeader(header));
+  writeFileAtomically(dir / kStoreHeaderName, serializeStoreHeader(fresh));
   return open(dir);
 }
 
@@ -365,10 +463,35 @@ bool BrickStore::hasFrame(int frame) const {
 
 std::filesystem::path BrickStore::framePath(int frame) const { return mDir / frameFileName(frame); }
 
+std::vector<int> BrickStore::missingFrames() const {
+  std::vector<int> missing;
+  for (int f : frames()) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(framePath(f), ec)) missing.push_back(f);
+  }
+  return missing;
+}
+
+std::vector<std::filesystem::path> BrickStore::unlistedFrameFiles() const {
+  std::vector<std::filesystem::path> files;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(mDir, ec)) {
+    const auto frame = frameFromFileName(entry.path().filename().string());
+    if (frame && !hasFrame(*frame)) files.push_back(entry.path());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
 void BrickStore::addFrame(int frame) {
+  FLIPSCOPE_CHECK(frame >= 0 && frame <= kMaxFrame, frame);
   std::lock_guard lock(mShared->mutex);
-  mShared->frames.insert(frame);
   mShared->indices.erase(frame);
+  if (mShared->frames.count(frame)) return;
+  std::set<int> frames = mShared->frames;
+  frames.insert(frame);
+  writeFileAtomically(mDir / kStoreHeaderName, serializeStoreHeader(mHeader, serializeList(frames)));
+  mShared->frames.swap(frames);
 }
 
 std::shared_ptr<const FrameIndex> BrickStore::frame(int frame) const {
@@ -378,8 +501,13 @@ std::shared_ptr<const FrameIndex> BrickStore::frame(int frame) const {
       throw InputError(mDir.string() + ": no frame " + std::to_string(frame) + " in the store");
     if (auto it = mShared->indices.find(frame); it != mShared->indices.end()) return it->second;
   }
-  auto index = std::make_shared<const FrameIndex>(readFrameIndex(framePath(frame), mHeader));
-  if (index->frame != frame) throw FileError(framePath(frame), "footer names frame " + std::to_string(index->frame));
+  const auto path = framePath(frame);
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec))
+    throw FileError(path, std::string("missing: ") + kStoreHeaderName + " lists frame " + std::to_string(frame) +
+                              ", but its file is gone");
+  auto index = std::make_shared<const FrameIndex>(readFrameIndex(path, mHeader));
+  if (index->frame != frame) throw FileError(path, "footer names frame " + std::to_string(index->frame));
   std::lock_guard lock(mShared->mutex);
   return mShared->indices.emplace(frame, index).first->second;
 }

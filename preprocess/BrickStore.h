@@ -3,10 +3,16 @@
 // bricks from here, never the original particle files.
 //
 // A store is a directory:
-//   store.fsh               StoreHeader: format version, domain, cell size, brick size, particle spacing
+//   store.fsh               StoreHeader: format version, domain, cell size, brick size, particle
+//                           spacing, the store's random 128-bit id, and the frame table
 //   frame_NNNNNN.fsf        one file per frame: brick payloads, then octree, brick table, footer
-// Every file is written atomically (AtomicFile), so an interrupted convert leaves either no
-// frame file or a complete one; frames are appended by writing new frame files.
+// Every file is written atomically (AtomicFile). The frame table in store.fsh lists the frames
+// of the store; it is rewritten (atomically) after each frame file is committed, so after an
+// interruption at any moment every listed frame is complete. A frame file the table does not
+// list is not part of the store (readers ignore it; the next convert removes it when it carries
+// the store's id). A store whose table is empty is incomplete (an interrupted or failed first
+// convert): `info` refuses it and the next convert into it starts it anew. Each frame file's
+// footer carries the store id, so a frame file from another store is refused.
 //
 // Frame file layout (little endian, offsets in bytes):
 //   [payload 0][payload 1]...           each brick's payload: zstd frame of an encoded brick
@@ -16,14 +22,17 @@
 // the checksum of its compressed payload, so any brick reads and verifies alone.
 //
 // Bricks are ordered by the Morton code of their brick coordinates; the octree is built over
-// that order (see PresenceOctree.h). Thread safety: a BrickStore is immutable after open() and
-// readBrick() may be called from any number of threads.
+// that order (see PresenceOctree.h). Thread safety: a BrickStore's header is immutable after
+// open(); readBrick() may be called from any number of threads; addFrame() (the writer's) is
+// serialised internally.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -34,9 +43,17 @@
 
 namespace flipscope {
 
-/// 2: StoreHeader::particleSpacing. Stores of other versions are refused (convert again).
-inline constexpr std::uint32_t kStoreVersion = 2;
+/// 2: StoreHeader::particleSpacing. 3: the store id (in store.fsh and every frame footer) and
+/// the frame table. Stores of other versions are refused (convert again).
+inline constexpr std::uint32_t kStoreVersion = 3;
 inline constexpr char kStoreHeaderName[] = "store.fsh";
+/// Frame numbers a store holds: 0 to kMaxFrame (six digits in the file name).
+inline constexpr int kMaxFrame = 999999;
+
+/// A store's identity: 16 random bytes (all zero: none yet).
+using StoreId = std::array<std::uint8_t, 16>;
+StoreId randomStoreId();
+std::string storeIdText(const StoreId& id);  ///< 32 hex digits
 
 /// The per-particle attribute a store carries, quantized to 16 bits over [min, max] of the frame.
 enum class AttributeKind : std::uint32_t { None = 0, Speed = 1 };
@@ -54,6 +71,8 @@ struct StoreHeader {
   /// World units: the particle spacing convert measured (ParticleSpacing.h), the cube root of
   /// the volume per particle; 0 = unknown. Not part of the domain: appending keeps the store's.
   double particleSpacing = 0;
+  /// Made by BrickStore::createOrAppend for a new store (random unless given); frames carry it.
+  StoreId id{};
 
   glm::dvec3 domainMax() const { return origin + glm::dvec3(brickGrid) * double(brickSize) * cellSize; }
   std::uint32_t cellsPerBrick() const { return brickSize * brickSize * brickSize; }
@@ -109,28 +128,39 @@ DecodedBrick decodeBrick(std::span<const std::byte> payload, const std::filesyst
 
 class BrickStore {
  public:
-  /// Opens an existing store; reads and verifies the header and lists the frame files.
-  /// Frame indices load lazily. Throws FileError.
+  /// Opens an existing store; reads and verifies the header and its frame table. Frame indices
+  /// load lazily. Throws FileError. A store with no frames opens (see incomplete()).
   static BrickStore open(const std::filesystem::path& dir);
-  /// Creates a new store directory with `header`, or, if one exists, checks that its header
-  /// matches (same brick size, cell size, origin, grid, attribute) and opens it for appending.
+  /// Creates a new store directory with `header` (its id, or a random one when it is all
+  /// zero), or, if a store with frames exists, checks that its header matches (same brick size,
+  /// cell size, origin, grid, attribute) and opens it for appending. An incomplete store (no
+  /// frames) is replaced by a new one with `header`.
   static BrickStore createOrAppend(const std::filesystem::path& dir, const StoreHeader& header);
   static bool exists(const std::filesystem::path& dir);
 
   const std::filesystem::path& directory() const { return mDir; }
   const StoreHeader& header() const { return mHeader; }
-  /// Frame numbers present, ascending.
+  /// The frame table: the frames of the store, ascending.
   std::vector<int> frames() const;
   bool hasFrame(int frame) const;
+  /// No frame yet: an interrupted or failed first convert.
+  bool incomplete() const { return frames().empty(); }
   std::filesystem::path framePath(int frame) const;
-  /// Loads (once, then cached) and verifies a frame's footer, octree and table.
+  /// Listed frames whose file does not exist, ascending.
+  std::vector<int> missingFrames() const;
+  /// Files in the directory named like frame files whose frame the table does not list.
+  std::vector<std::filesystem::path> unlistedFrameFiles() const;
+  /// Loads (once, then cached) and verifies a frame's footer, octree and table. Throws
+  /// InputError for a frame the table does not list, FileError naming the file when it is
+  /// missing, damaged or from another store.
   std::shared_ptr<const FrameIndex> frame(int frame) const;
   /// Reads, verifies and decodes one brick. Thread safe.
   DecodedBrick readBrick(const FrameIndex& frame, std::uint32_t brickIndex) const;
   /// Reads one brick's compressed payload and verifies its checksum. Thread safe.
   std::vector<std::byte> readPayload(const FrameIndex& frame, std::uint32_t brickIndex) const;
 
-  /// Called by FrameWriter after committing a frame file.
+  /// Lists `frame` in the frame table (rewrites store.fsh atomically when it is new). Called
+  /// after the frame file is committed. Throws FileError.
   void addFrame(int frame);
 
  private:
@@ -141,10 +171,20 @@ class BrickStore {
 };
 
 /// Parses a frame file completely in memory-bounded steps (footer, octree, table).
-/// Throws FileError naming the file and the field on any truncation or corruption.
+/// Throws FileError naming the file and the field on any truncation or corruption, and when
+/// the footer's store id is not header.id (a frame of another store).
 FrameIndex readFrameIndex(const std::filesystem::path& file, const StoreHeader& header);
 
-std::vector<std::byte> serializeStoreHeader(const StoreHeader& header);
-StoreHeader parseStoreHeader(std::span<const std::byte> bytes, const std::filesystem::path& file);
+/// store.fsh: the header and the frame table (frames ascending, unique, 0..kMaxFrame; stored as
+/// runs of consecutive frames).
+std::vector<std::byte> serializeStoreHeader(const StoreHeader& header, const std::vector<int>& frames = {});
+/// Throws FileError on any truncation, corruption, unknown version or trailing bytes. The frame
+/// table goes to `frames` when given.
+StoreHeader parseStoreHeader(std::span<const std::byte> bytes, const std::filesystem::path& file,
+                             std::vector<int>* frames = nullptr);
+
+/// The frame file name of `frame` (frame_NNNNNN.fsf), and back (nullopt for other names).
+std::string frameFileName(int frame);
+std::optional<int> frameFromFileName(const std::string& name);
 
 }  // namespace flipscope

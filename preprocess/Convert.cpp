@@ -1,11 +1,17 @@
 // convert(): particle files -> BrickStore, in core or out of core (see Convert.h).
 #include "preprocess/Convert.h"
 
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 
@@ -13,6 +19,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include "core/AtomicFile.h"
 #include "core/Error.h"
 #include "preprocess/BrickBinning.h"
 #include "preprocess/FrameFile.h"
@@ -25,6 +32,33 @@ using detail::KeyBatch;
 using detail::KeyGrid;
 
 constexpr std::size_t kSpillBufferBytes = 64 << 10;
+/// Spill files are `<kSpillPrefix><pid>-<frame>[-<n>]-<bucket>`.
+constexpr std::string_view kSpillPrefix = ".flipscope-spill-";
+
+/// The test hook of Convert.h (FLIPSCOPE_CONVERT_STOP): raises the configured signal in the
+/// calling thread at the configured pass through `point`.
+void stopPoint(const char* point) {
+  struct Stop {
+    std::string point;
+    long pass = 0;
+    int signal = 0;
+    std::atomic<long> seen{0};
+  };
+  static Stop* const stop = [] () -> Stop* {
+    const char* spec = std::getenv("FLIPSCOPE_CONVERT_STOP");
+    if (!spec || !*spec) return nullptr;
+    auto* s = new Stop;
+    std::string text = spec;
+    const auto a = text.find(':'), b = a == std::string::npos ? a : text.find(':', a + 1);
+    s->point = text.substr(0, a);
+    s->pass = a == std::string::npos ? 1 : std::atol(text.c_str() + a + 1);
+    const std::string name = b == std::string::npos ? "KILL" : text.substr(b + 1);
+    s->signal = name == "INT" ? SIGINT : name == "TERM" ? SIGTERM : name == "HUP" ? SIGHUP : SIGKILL;
+    return s;
+  }();
+  if (!stop || stop->point != point) return;
+  if (++stop->seen == stop->pass) ::raise(stop->signal);
+}
 
 /// Memory plan of one conversion, all derived from the budget.
 struct MemoryPlan {
@@ -61,6 +95,7 @@ class SpillBuckets {
       if (b.file) std::fclose(b.file);
       std::error_code ec;
       std::filesystem::remove(b.path, ec);
+      b.cleanup.release();
     }
   }
   SpillBuckets(const SpillBuckets&) = delete;
@@ -140,16 +175,20 @@ class SpillBuckets {
     std::FILE* file = nullptr;
     std::vector<std::byte> buffer;
     std::uint64_t records = 0;
+    CleanupOnSignal cleanup;  ///< from before the file exists until it is removed
   };
   void flush(Bucket& b) {
     if (b.buffer.empty()) return;
     if (!b.file) {
+      const DeferCleanupSignals step;  // registered and created as one step
+      b.cleanup = CleanupOnSignal(b.path);
       b.file = std::fopen(b.path.c_str(), "wb");
       if (!b.file) throw FileError(b.path, std::string("cannot create spill file: ") + std::strerror(errno));
     }
     if (std::fwrite(b.buffer.data(), 1, b.buffer.size(), b.file) != b.buffer.size())
       throw FileError(b.path, std::string("spill write failed (disk full?): ") + std::strerror(errno));
     b.buffer.clear();
+    stopPoint("spill");
   }
 
   std::uint32_t mShift, mBits;
@@ -163,7 +202,7 @@ class FrameBinner {
   FrameBinner(const KeyGrid& grid, bool attribute, const MemoryPlan& plan, const ConvertOptions& options,
               std::filesystem::path scratchDir, int frame)
       : mGrid(grid), mAttribute(attribute), mPlan(plan), mOptions(options), mScratch(std::move(scratchDir)),
-        mPrefix(".spill-" + std::to_string(::getpid()) + "-" + std::to_string(frame)) {}
+        mPrefix(std::string(kSpillPrefix) + std::to_string(::getpid()) + "-" + std::to_string(frame)) {}
 
   void add(const ParticleChunk& chunk) {
     if (mSpill) {
@@ -252,6 +291,7 @@ class FrameBinner {
     detail::binKeys(keys, scratch, mGrid, mAttribute, mOptions.zstdLevel, [&](detail::EncodedBrick&& brick) {
       writer.addBrick(brick.coord, brick.particles, brick.cells, brick.payload);
       mStats.particles += brick.particles;
+      stopPoint("brick");
     });
     detail::KeyVector().swap(keys);
   }
@@ -275,6 +315,19 @@ std::unique_ptr<ParticleSource> openFrame(const FrameInput& input, const ReadOpt
   for (const auto& file : input.files) parts.push_back(openParticleFile(file, read));
   if (parts.size() == 1) return std::move(parts.front());
   return concatSources(std::move(parts));
+}
+
+/// The input files for a message: the first three, then how many more.
+std::string inputFileNames(const std::vector<FrameInput>& inputs) {
+  std::string names;
+  std::size_t count = 0, shown = 0;
+  for (const auto& input : inputs)
+    for (const auto& file : input.files) {
+      if (++count > 3) continue;
+      names += (shown++ ? ", " : "") + file.string();
+    }
+  if (count > 3) names += " and " + std::to_string(count - 3) + " more files";
+  return names;
 }
 
 Box scanBounds(ParticleSource& source, std::size_t chunkParticles, Progress* progress) {
@@ -358,7 +411,115 @@ StoreHeader chooseHeader(const Box& bounds, const ConvertOptions& options, bool 
   return makeStoreHeader(bounds, o, attribute);
 }
 
+/// The store directory for the length of a convert: created when missing (and then removed
+/// again, on failure or SIGINT/SIGTERM/SIGHUP, if nothing is left in it), and locked (flock)
+/// so that a second convert into the same store is refused instead of racing on store.fsh.
+class StoreDirectory {
+ public:
+  explicit StoreDirectory(const std::filesystem::path& dir) : mDir(dir) {
+    std::error_code ec;
+    const DeferCleanupSignals step;  // registered and created as one step
+    if (!std::filesystem::exists(dir, ec)) {
+      mCleanup = CleanupOnSignal(dir, CleanupOnSignal::Kind::Directory);
+      if (!std::filesystem::create_directories(dir, ec) && ec)
+        throw FileError(dir, "cannot create the store directory: " + ec.message());
+      mCreated = true;
+    } else if (!std::filesystem::is_directory(dir, ec)) {
+      throw FileError(dir, "exists and is not a directory (a brick store is one)");
+    }
+    mFd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (mFd < 0) throw FileError(dir, std::string("cannot open the store directory: ") + std::strerror(errno));
+    if (::flock(mFd, LOCK_EX | LOCK_NB) != 0 && errno == EWOULDBLOCK) {
+      ::close(mFd);
+      mFd = -1;
+      throw FileError(dir, "another flipscope convert is writing this store; wait for it to finish");
+    }  // other errors: a filesystem without locks; convert unlocked
+  }
+  ~StoreDirectory() {
+    if (mFd >= 0) ::close(mFd);
+    std::error_code ec;
+    if (mCreated && std::filesystem::is_empty(mDir, ec)) std::filesystem::remove(mDir, ec);
+  }
+  StoreDirectory(const StoreDirectory&) = delete;
+  StoreDirectory& operator=(const StoreDirectory&) = delete;
+
+ private:
+  std::filesystem::path mDir;
+  CleanupOnSignal mCleanup;
+  bool mCreated = false;
+  int mFd = -1;
+};
+
+/// store.fsh of a store that has no frame yet: removed again when the convert fails (an
+/// exception) or is stopped by SIGINT/SIGTERM/SIGHUP before its first frame, so that a failed
+/// convert never leaves a store of only store.fsh. SIGKILL leaves it: that store has no frames
+/// and reports itself incomplete.
+class FramelessHeader {
+ public:
+  explicit FramelessHeader(const std::filesystem::path& file) : mFile(file), mCleanup(file) {}
+  ~FramelessHeader() {
+    if (!mArmed) return;
+    std::error_code ec;
+    std::filesystem::remove(mFile, ec);
+  }
+  FramelessHeader(const FramelessHeader&) = delete;
+  FramelessHeader& operator=(const FramelessHeader&) = delete;
+  /// The store has a frame: keep store.fsh.
+  void keep() {
+    mArmed = false;
+    mCleanup.release();
+  }
+
+ private:
+  std::filesystem::path mFile;
+  CleanupOnSignal mCleanup;
+  bool mArmed = true;
+};
+
+std::uint64_t fileBytes(const std::filesystem::path& file) {
+  std::error_code ec;
+  const auto bytes = std::filesystem::file_size(file, ec);
+  return ec ? 0 : bytes;
+}
+
+/// The PID in a spill file name (`.flipscope-spill-<pid>-...`).
+std::optional<long> spillFileOwner(std::string_view name) {
+  if (name.substr(0, kSpillPrefix.size()) != kSpillPrefix) return std::nullopt;
+  name.remove_prefix(kSpillPrefix.size());
+  long pid = 0;
+  std::size_t i = 0;
+  for (; i < name.size() && i < 18 && name[i] >= '0' && name[i] <= '9'; ++i) pid = pid * 10 + (name[i] - '0');
+  if (i == 0 || i >= name.size() || name[i] != '-' || pid <= 0) return std::nullopt;
+  return pid;
+}
+
+void noteStaleFiles(const StaleFiles& stale, const std::string& where, ConvertReport& report) {
+  if (stale.files == 0) return;
+  report.warnings.push_back("removed " + std::to_string(stale.files) + " stale temporary or spill file(s) (" +
+                            Progress::humanCount(double(stale.bytes)) + "B) that an interrupted convert left in " +
+                            where);
+}
+
 }  // namespace
+
+StaleFiles removeStaleFiles(const std::filesystem::path& dir, bool temporaries) {
+  StaleFiles removed;
+  std::error_code ec;
+  const long self = long(::getpid());
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    std::optional<long> owner = spillFileOwner(name);
+    if (!owner && temporaries) owner = temporaryFileOwner(name);
+    if (!owner || *owner == self || processExists(*owner)) continue;
+    const std::uint64_t bytes = fileBytes(entry.path());
+    std::error_code removeError;
+    if (std::filesystem::remove(entry.path(), removeError)) {
+      ++removed.files;
+      removed.bytes += bytes;
+    }
+  }
+  return removed;
+}
 
 StoreHeader makeStoreHeader(const Box& bounds, const ConvertOptions& options, bool attribute) {
   if (options.brickSize != 32 && options.brickSize != 64 && options.brickSize != 128)
@@ -393,8 +554,11 @@ StoreHeader makeStoreHeader(const Box& bounds, const ConvertOptions& options, bo
   return h;
 }
 
-FrameReport convertFrame(ParticleSource& source, BrickStore& store, int frame, const ConvertOptions& options,
-                         Progress* progress) {
+namespace {
+
+/// convertFrame(); `frameless`: store.fsh of a store without frames, kept once this frame is listed.
+FrameReport convertOneFrame(ParticleSource& source, BrickStore& store, int frame, const ConvertOptions& options,
+                            Progress* progress, FramelessHeader* frameless) {
   const auto start = std::chrono::steady_clock::now();
   const StoreHeader& header = store.header();
   const bool attribute = header.attribute != AttributeKind::None;
@@ -409,13 +573,38 @@ FrameReport convertFrame(ParticleSource& source, BrickStore& store, int frame, c
   while (source.read(chunk, plan.chunkParticles)) {
     binner.add(chunk);
     if (progress) progress->advance(chunk.size());
+    stopPoint("chunk");
   }
   FrameWriter writer(store.framePath(frame), header, frame);
   FrameReport report;
   report.frame = frame;
   report.stats = binner.finish(writer);
-  FrameIndex index = writer.finish(report.stats);
-  store.addFrame(frame);
+  // A frame the table does not list yet goes again if the convert stops before the table lists
+  // it: the store never keeps a frame file it does not know.
+  const bool listed = store.hasFrame(frame);
+  CleanupOnSignal unlisted;
+  std::optional<FrameIndex> committed;
+  {
+    const DeferCleanupSignals step;  // registered and renamed into place as one step
+    if (!listed) unlisted = CleanupOnSignal(store.framePath(frame));
+    committed = writer.finish(report.stats);
+  }
+  const FrameIndex& index = *committed;
+  stopPoint("frame-file");
+  {
+    // Listing the frame and keeping its file (and store.fsh) is one step for the signal handler.
+    const DeferCleanupSignals commit;
+    try {
+      store.addFrame(frame);
+    } catch (...) {
+      std::error_code ec;
+      if (!listed) std::filesystem::remove(store.framePath(frame), ec);
+      throw;
+    }
+    unlisted.release();
+    if (frameless) frameless->keep();
+  }
+  stopPoint("frame");
   report.bricks = std::uint32_t(index.bricks.size());
   report.storeBytes = index.fileBytes;
   report.spillBuckets = binner.spillBuckets();
@@ -423,9 +612,20 @@ FrameReport convertFrame(ParticleSource& source, BrickStore& store, int frame, c
   return report;
 }
 
+}  // namespace
+
+FrameReport convertFrame(ParticleSource& source, BrickStore& store, int frame, const ConvertOptions& options,
+                         Progress* progress) {
+  return convertOneFrame(source, store, frame, options, progress, nullptr);
+}
+
 ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesystem::path& storeDir,
                       const ConvertOptions& options) {
   if (inputs.empty()) throw InputError("convert: no input frames");
+  for (const auto& input : inputs)
+    if (input.frame < 0 || input.frame > kMaxFrame)
+      throw InputError("convert: frame " + std::to_string(input.frame) + " is outside the frames a store holds, 0 to " +
+                       std::to_string(kMaxFrame));
   // Open every frame once to learn velocities and counts (headers only).
   bool allVelocity = true;
   std::uint64_t hinted = 0;
@@ -438,12 +638,42 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
   if (wantAttribute && !allVelocity) throw InputError("--attribute speed needs velocities in every input file");
 
   ConvertReport report;
+  const StoreDirectory directory(storeDir);
+  stopPoint("directory");
+  // Left by a killed convert (their writer's PID is gone): temporaries, spill files, and frame
+  // files of this store that its table does not list.
+  noteStaleFiles(removeStaleFiles(storeDir, true), storeDir.string(), report);
+  if (!options.scratchDir.empty() && std::filesystem::is_directory(options.scratchDir))
+    noteStaleFiles(removeStaleFiles(options.scratchDir, false), options.scratchDir.string(), report);
   StoreHeader header;
+  bool keepHeader = false;
   if (BrickStore::exists(storeDir)) {
-    header = BrickStore::open(storeDir).header();
-    report.cellSizeOrigin = "kept from the existing store";
-    report.spacingOrigin = "the existing store";
-  } else {
+    const BrickStore existing = BrickStore::open(storeDir);
+    StaleFiles unlisted;
+    for (const auto& file : existing.unlistedFrameFiles()) {
+      try {
+        readFrameIndex(file, existing.header());  // a complete frame of this store, never listed
+      } catch (const FileError&) {
+        report.warnings.push_back(file.string() +
+                                  ": not in the store's frame table and not one of its frames; left alone");
+        continue;
+      }
+      const std::uint64_t bytes = fileBytes(file);
+      std::error_code ec;
+      if (std::filesystem::remove(file, ec)) ++unlisted.files, unlisted.bytes += bytes;
+    }
+    noteStaleFiles(unlisted, storeDir.string() + " (frame files never listed in store.fsh)", report);
+    if (!existing.incomplete()) {
+      header = existing.header();
+      keepHeader = true;
+      report.cellSizeOrigin = "kept from the existing store";
+      report.spacingOrigin = "the existing store";
+    } else {
+      report.warnings.push_back(storeDir.string() +
+                                ": the store has no frames (an interrupted or failed convert); starting it anew");
+    }
+  }
+  if (!keepHeader) {
     SpacingEstimate spacing;
     if (options.particleSpacing) {
       spacing.spacing = *options.particleSpacing;
@@ -462,17 +692,31 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
       for (const auto& input : inputs)
         bounds.extend(scanBounds(*openFrame(input, options.read), plan.chunkParticles, &progress));
       progress.finish();
+      if (bounds.isEmpty())
+        throw InputError(inputFileNames(inputs) +
+                         ": no finite particle positions (no particles, or only NaN/Inf ones): cannot derive a "
+                         "domain (give --domain)");
     }
     header = chooseHeader(bounds, options, wantAttribute, spacing, report);
   }
-  BrickStore store = BrickStore::createOrAppend(storeDir, header);
+  std::optional<FramelessHeader> frameless;
+  std::optional<BrickStore> created;
+  {
+    const DeferCleanupSignals step;  // store.fsh registered and written as one step
+    if (!keepHeader) frameless.emplace(storeDir / kStoreHeaderName);
+    created = BrickStore::createOrAppend(storeDir, header);
+  }
+  BrickStore& store = *created;
   report.header = store.header();
+  stopPoint("header");
   Progress progress("convert", hinted, "particles", options.progress);
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     progress.setLabel("convert frame " + std::to_string(inputs[i].frame) + " (" + std::to_string(i + 1) + "/" +
                       std::to_string(inputs.size()) + ")");
     auto source = openFrame(inputs[i], options.read);
-    report.frames.push_back(convertFrame(*source, store, inputs[i].frame, options, &progress));
+    report.frames.push_back(convertOneFrame(*source, store, inputs[i].frame, options, &progress,
+                                            frameless ? &*frameless : nullptr));
+    frameless.reset();  // kept: the store has a frame
   }
   progress.setLabel("convert");
   std::uint64_t bricks = 0, bytes = 0;

@@ -9,7 +9,7 @@
 // Out of core: memory stays within `memoryBudget` (plus a small constant) whatever the input
 // size. Keys that do not fit are spilled to bucket files by Morton range of their brick and
 // each bucket is binned on its own (recursively split when the data is skewed); the store is
-// byte-identical to an in-core conversion.
+// identical to an in-core conversion but for the store id (random per store).
 //
 // Oddities are counted, reported (FrameStats) and skipped: NaN/Inf coordinates, particles
 // outside `domain`.
@@ -19,6 +19,25 @@
 // kDefaultResolution cells along the longest axis, with a warning, when the spacing is unknown
 // or the grid would exceed kMaxCellsPerAxis. The spacing is measured and recorded in the
 // store header either way (StoreHeader::particleSpacing).
+//
+// Interruptions (see BrickStore.h for the frame table): convert() locks the store directory
+// (flock; a second convert into it is refused), removes what a killed convert left there (AtomicFile
+// temporaries and spill files whose PID is gone, and frame files of the store that its table
+// never listed), then commits each frame file before listing it in store.fsh. A new store's
+// store.fsh (no frames yet) and a directory convert() created are removed again when it fails
+// before the first frame. Every temporary, spill file and not yet listed frame file is registered
+// with CleanupOnSignal, so SIGINT, SIGTERM and SIGHUP remove them once the command installed
+// installCleanupSignalHandlers() (`flipscope convert` does); creating a file and registering
+// it, and listing a frame and releasing its registration, are each one DeferCleanupSignals
+// step, so a signal on any thread at any moment leaves only complete, listed frames (and no
+// store.fsh without frames). After SIGKILL the store holds its complete, listed frames (or no
+// frames: incomplete) and the next convert removes the rest.
+//
+// Test hook: FLIPSCOPE_CONVERT_STOP="<point>:<n>:<KILL|INT|TERM|HUP>" raises that signal in the
+// converting thread the n-th time convert passes <point>: directory (created and locked), header
+// (store.fsh written), chunk (a chunk of particles read), spill (a spill file written to), brick
+// (a brick appended to the frame's temporary), frame-file (the frame file committed, not listed
+// yet), frame (listed in store.fsh).
 #pragma once
 
 #include <cstdint>
@@ -88,7 +107,18 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
 /// the cell size is not positive.
 StoreHeader makeStoreHeader(const Box& bounds, const ConvertOptions& options, bool attribute);
 
-/// Bins one frame read from `source` into `store` (lower-level step of convert()).
+/// What removeStaleFiles() removed.
+struct StaleFiles {
+  std::uint64_t files = 0;
+  std::uint64_t bytes = 0;
+};
+
+/// Removes from `dir` the spill files and, with `temporaries`, the AtomicFile temporaries that a
+/// process now gone left (the PID in their names, see AtomicFile.h); never this process's own.
+StaleFiles removeStaleFiles(const std::filesystem::path& dir, bool temporaries);
+
+/// Bins one frame read from `source` into `store` (lower-level step of convert()): writes its
+/// frame file, then lists it in the store's frame table.
 FrameReport convertFrame(ParticleSource& source, BrickStore& store, int frame, const ConvertOptions& options,
                          Progress* progress = nullptr);
 

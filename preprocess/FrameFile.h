@@ -16,9 +16,10 @@ namespace flipscope {
 
 inline constexpr char kFrameMagic[8] = {'F', 'S', 'F', 'R', 'A', 'M', 'E', '1'};
 inline constexpr char kFooterMagic[8] = {'F', 'S', 'F', 'O', 'O', 'T', 'R', '1'};
-inline constexpr std::uint64_t kFrameFooterBytes = 88;
+inline constexpr std::uint64_t kFrameFooterBytes = 104;
 
-/// The last kFrameFooterBytes of a frame file.
+/// The last kFrameFooterBytes of a frame file. The version sits at the same distance from the
+/// end of the file in every version, so that an old frame is named as such.
 struct FrameFooter {
   std::uint64_t octreeOffset = 0;
   std::uint32_t octreeLevels = 0;
@@ -27,13 +28,15 @@ struct FrameFooter {
   std::uint32_t brickCount = 0;
   std::int32_t frame = 0;
   FrameStats stats;
-  std::uint32_t version = kStoreVersion;
+  StoreId storeId{};                ///< the id of the store the frame belongs to (since version 3)
+  std::uint32_t version = kStoreVersion;  ///< 24 bytes before the end in every version
   std::uint32_t reserved = 0;
   std::uint64_t indexChecksum = 0;  ///< over octree, table and the footer bytes before this field
 };
 
-/// Writes one frame file atomically. Bricks must be added in strictly ascending Morton order
-/// of their coordinates; finish() builds the octree and commits. Not thread safe.
+/// Writes one frame file atomically, carrying header.id. Bricks must be added in strictly
+/// ascending Morton order of their coordinates; finish() builds the octree and commits. Not
+/// thread safe.
 class FrameWriter {
  public:
   FrameWriter(const std::filesystem::path& file, const StoreHeader& header, int frame);

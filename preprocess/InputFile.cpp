@@ -1,5 +1,6 @@
 #include "preprocess/InputFile.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
@@ -20,15 +21,39 @@ InputFile::InputFile(std::filesystem::path path) : mPath(std::move(path)) {
   }
 }
 
-InputFile::~InputFile() { std::fclose(mFile); }
+InputFile::InputFile(std::filesystem::path name, std::span<const std::byte> bytes)
+    : mPath(std::move(name)), mMemory(bytes), mSize(bytes.size()) {}
+
+InputFile::InputFile(InputFile&& other) noexcept
+    : mPath(std::move(other.mPath)),
+      mFile(std::exchange(other.mFile, nullptr)),
+      mMemory(other.mMemory),
+      mSize(other.mSize),
+      mOffset(other.mOffset),
+      mLineTerminated(other.mLineTerminated) {}
+
+InputFile::~InputFile() {
+  if (mFile) std::fclose(mFile);
+}
 
 void InputFile::seek(std::uint64_t offset) {
+  if (!mFile) {
+    if (offset > mSize) throw FileError(mPath, "cannot seek to byte " + std::to_string(offset) + ": past the end");
+    mOffset = offset;
+    return;
+  }
   if (::fseeko(mFile, static_cast<off_t>(offset), SEEK_SET) != 0)
     throw FileError(mPath, "cannot seek to byte " + std::to_string(offset) + ": " + std::strerror(errno));
   mOffset = offset;
 }
 
 std::size_t InputFile::read(void* data, std::size_t bytes) {
+  if (!mFile) {
+    const std::size_t n = std::size_t(std::min<std::uint64_t>(bytes, mSize - mOffset));
+    if (n) std::memcpy(data, mMemory.data() + mOffset, n);
+    mOffset += n;
+    return n;
+  }
   std::size_t n = std::fread(data, 1, bytes, mFile);
   if (n < bytes && std::ferror(mFile))
     throw FileError(mPath, "read failed at byte " + std::to_string(mOffset + n) + ": " + std::strerror(errno));
@@ -36,12 +61,19 @@ std::size_t InputFile::read(void* data, std::size_t bytes) {
   return n;
 }
 
+int InputFile::get() {
+  if (!mFile) return mOffset < mSize ? static_cast<int>(static_cast<unsigned char>(mMemory[mOffset])) : EOF;
+  int c = getc_unlocked(mFile);
+  if (c == EOF && std::ferror(mFile)) throw FileError(mPath, "read failed at byte " + std::to_string(mOffset));
+  return c;
+}
+
 bool InputFile::readLine(std::string& line, std::size_t maxLength) {
   line.clear();
+  mLineTerminated = false;
   for (;;) {
-    int c = getc_unlocked(mFile);
+    int c = get();
     if (c == EOF) {
-      if (std::ferror(mFile)) throw FileError(mPath, "read failed at byte " + std::to_string(mOffset));
       if (!line.empty() && line.back() == '\r') line.pop_back();
       return !line.empty();
     }
@@ -52,6 +84,7 @@ bool InputFile::readLine(std::string& line, std::size_t maxLength) {
                                  std::to_string(maxLength) + " bytes");
     line.push_back(static_cast<char>(c));
   }
+  mLineTerminated = true;
   if (!line.empty() && line.back() == '\r') line.pop_back();
   return true;
 }

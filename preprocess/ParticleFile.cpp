@@ -89,13 +89,27 @@ std::unique_ptr<ParticleSource> openParticleFile(const std::filesystem::path& pa
   if (!std::filesystem::exists(path, ec)) throw FileError(path, "no such file");
   switch (format) {
     case ParticleFormat::Raw:
-      return detail::openRawParticles(path);
+      return detail::openRawParticles(InputFile(path));
     case ParticleFormat::Ply:
-      return detail::openPlyParticles(path, options);
+      return detail::openPlyParticles(InputFile(path), options);
     case ParticleFormat::Vdb:
       return detail::openVdbPoints(path, options);
   }
   FLIPSCOPE_CHECK(false, "format=" << int(format));
+}
+
+std::unique_ptr<ParticleSource> detail::openParticleBytes(const std::filesystem::path& name,
+                                                          std::span<const std::byte> bytes,
+                                                          const ReadOptions& options) {
+  switch (formatOf(name)) {
+    case ParticleFormat::Raw:
+      return openRawParticles(InputFile(name, bytes));
+    case ParticleFormat::Ply:
+      return openPlyParticles(InputFile(name, bytes), options);
+    case ParticleFormat::Vdb:
+      return openVdbPointsBytes(name, bytes, options);
+  }
+  FLIPSCOPE_CHECK(false, "unknown format");
 }
 
 std::unique_ptr<ParticleSource> concatSources(std::vector<std::unique_ptr<ParticleSource>> parts) {

@@ -219,7 +219,8 @@ PlyHeader readPlyHeader(InputFile& file) {
 
 class PlyReader final : public ParticleSource {
  public:
-  PlyReader(const std::filesystem::path& path, const ReadOptions& options) : mFile(path) {
+  PlyReader(InputFile file, const ReadOptions& options) : mFile(std::move(file)) {
+    const std::filesystem::path& path = mFile.path();
     mHeader = readPlyHeader(mFile);
     const char* names[6] = {"x", "y", "z", "vx", "vy", "vz"};
     for (int i = 0; i < 6; ++i) {
@@ -299,6 +300,12 @@ class PlyReader final : public ParticleSource {
         throw FileError(mFile.path(), "file ends at particle " + std::to_string(mNext + k) + " of " +
                                           std::to_string(mHeader.vertexCount) + " (line " + std::to_string(lineNumber) +
                                           ", byte offset " + std::to_string(mFile.offset()) + ")");
+      // A vertex line must end with a line break: without it the file may be cut inside the
+      // last number, which would read as a different value.
+      if (!mFile.lineTerminated())
+        throw FileError(mFile.path(), "file ends inside line " + std::to_string(lineNumber) + " (particle " +
+                                          std::to_string(mNext + k) + " of " + std::to_string(mHeader.vertexCount) +
+                                          ") without a line break: truncated?");
       words.clear();
       for (std::size_t i = 0; i < mLine.size();) {
         while (i < mLine.size() && std::isspace(static_cast<unsigned char>(mLine[i]))) ++i;
@@ -410,8 +417,8 @@ class PlyWriter final : public ParticleWriter {
 
 }  // namespace
 
-std::unique_ptr<ParticleSource> openPlyParticles(const std::filesystem::path& path, const ReadOptions& options) {
-  return std::make_unique<PlyReader>(path, options);
+std::unique_ptr<ParticleSource> openPlyParticles(InputFile file, const ReadOptions& options) {
+  return std::make_unique<PlyReader>(std::move(file), options);
 }
 
 std::unique_ptr<ParticleWriter> createPlyWriter(const std::filesystem::path& path, const WriteOptions& options) {

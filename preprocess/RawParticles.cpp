@@ -17,9 +17,9 @@ constexpr std::uint64_t kRawParticleBytes = 12;
 
 class RawReader final : public ParticleSource {
  public:
-  explicit RawReader(const std::filesystem::path& path) : mFile(path) {
+  explicit RawReader(InputFile file) : mFile(std::move(file)) {
     if (mFile.size() % kRawParticleBytes != 0)
-      throw FileError(path, "raw particle file size " + std::to_string(mFile.size()) +
+      throw FileError(mFile.path(), "raw particle file size " + std::to_string(mFile.size()) +
                                 " bytes is not a multiple of 12 (float32 x y z)");
     mCount = mFile.size() / kRawParticleBytes;
   }
@@ -65,8 +65,8 @@ class RawWriter final : public ParticleWriter {
 
 }  // namespace
 
-std::unique_ptr<ParticleSource> openRawParticles(const std::filesystem::path& path) {
-  return std::make_unique<RawReader>(path);
+std::unique_ptr<ParticleSource> openRawParticles(InputFile file) {
+  return std::make_unique<RawReader>(std::move(file));
 }
 
 std::unique_ptr<ParticleWriter> createRawWriter(const std::filesystem::path& path) {

@@ -29,6 +29,20 @@ double spacingInCells(const StoreHeader& header) {
   return header.particleSpacing > 0 && header.cellSize > 0 ? header.particleSpacing / header.cellSize : 0;
 }
 
+std::string incompleteStoreReason() {
+  return "incomplete store: no frames (an interrupted or failed convert left it); convert again";
+}
+
+std::vector<std::string> checkFrameTable(const BrickStore& store) {
+  std::vector<std::string> problems;
+  if (store.incomplete())
+    problems.push_back((store.directory() / kStoreHeaderName).string() + ": " + incompleteStoreReason());
+  for (int f : store.missingFrames())
+    problems.push_back(store.framePath(f).string() + ": missing: " + kStoreHeaderName + " lists frame " +
+                       std::to_string(f) + ", but its file is gone");
+  return problems;
+}
+
 std::vector<std::string> verifyFrame(const BrickStore& store, const FrameIndex& frame) {
   std::vector<std::string> errors;
   std::mutex mutex;

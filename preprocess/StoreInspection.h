@@ -27,6 +27,14 @@ FrameSummary summarizeFrame(const FrameIndex& frame, const StoreHeader& header);
 /// The particle spacing the store recorded, in cells of the store (0 when unknown).
 double spacingInCells(const StoreHeader& header);
 
+/// Why a store with no frames is refused (names no file; the caller adds store.fsh).
+std::string incompleteStoreReason();
+
+/// Checks the store's frame set against its frame table, without reading frames: one message
+/// when the store has no frames (incomplete), one per listed frame whose file is missing, each
+/// naming the file. Empty when every listed frame is there.
+std::vector<std::string> checkFrameTable(const BrickStore& store);
+
 /// Reads every brick of `frame`, checks its checksum and decodes it. Returns one message per
 /// damaged brick (naming the file and the brick); empty when the frame is intact. Parallel.
 std::vector<std::string> verifyFrame(const BrickStore& store, const FrameIndex& frame);

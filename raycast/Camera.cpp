@@ -105,11 +105,18 @@ glm::dvec3 readVector(const nlohmann::json& json, const char* key, const std::fi
 }  // namespace
 
 Camera loadCamera(const std::filesystem::path& file) {
-  std::ifstream in(file);
+  std::ifstream in(file, std::ios::binary);
   if (!in) throw FileError(file, "cannot open camera file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw FileError(file, "cannot read camera file");
+  return parseCameraJson(text.str(), file);
+}
+
+Camera parseCameraJson(std::string_view text, const std::filesystem::path& file) {
   nlohmann::json json;
   try {
-    json = nlohmann::json::parse(in);
+    json = nlohmann::json::parse(text);
   } catch (const nlohmann::json::exception& e) {
     throw FileError(file, std::string("not valid JSON: ") + e.what());
   }

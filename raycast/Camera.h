@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <string_view>
 
 #include <glm/vec3.hpp>
 
@@ -44,6 +45,8 @@ Camera parseCamera(const std::string& option, const std::string& text);
 /// JSON: {"eye": [x, y, z], "target": [x, y, z], "up": [x, y, z], "fov": degrees}; "up" and
 /// "fov" are optional. loadCamera throws FileError naming the file and the field.
 Camera loadCamera(const std::filesystem::path& file);
+/// loadCamera's parser: the JSON `text` of the camera file `file` (named in errors).
+Camera parseCameraJson(std::string_view text, const std::filesystem::path& file);
 void saveCamera(const std::filesystem::path& file, const Camera& camera);
 
 }  // namespace flipscope

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "core/AtomicFile.h"
 #include "core/Error.h"
 #include "preprocess/Convert.h"
 #include "preprocess/InputSequence.h"
@@ -30,6 +31,8 @@ struct ConvertArgs {
 };
 
 void runConvert(const ConvertArgs& a) {
+  // SIGINT, SIGTERM and SIGHUP remove the temporary and spill files, then end the process.
+  installCleanupSignalHandlers();
   ConvertOptions options;
   if (a.cellSize != 0) options.cellSize = a.cellSize;
   if (a.resolution != 0) options.resolution = a.resolution;

@@ -1,7 +1,10 @@
 // flipscope info: what a brick store holds, per frame, and --verify of every checksum.
+// A store with no frames (an interrupted or failed convert) and a store missing a frame its
+// frame table lists are refused: exit 3, or with --verify reported as damage, exit 1.
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 
@@ -24,8 +27,24 @@ void runInfo(const InfoArgs& a) {
   const BrickStore store = BrickStore::open(a.store);
   const StoreHeader& h = store.header();
   std::vector<FrameSummary> frames;
-  std::vector<std::string> damage;
+  std::vector<std::string> damage = checkFrameTable(store);
+  if (!damage.empty() && !a.verify) {
+    const std::vector<int> missing = store.missingFrames();
+    if (missing.empty()) throw FileError(store.directory() / kStoreHeaderName, incompleteStoreReason());
+    std::string reason = std::string("missing: ") + kStoreHeaderName + " lists frame " + std::to_string(missing[0]) +
+                         ", but its file is gone";
+    if (missing.size() > 1)
+      reason +=
+          " (and " + std::to_string(missing.size() - 1) + " more listed frame(s) missing; info --verify lists them)";
+    throw FileError(store.framePath(missing[0]), reason);
+  }
+  if (a.verify)
+    for (const auto& file : store.unlistedFrameFiles())
+      std::fprintf(stderr, "note: %s: not in %s's frame table, so not part of the store\n", file.c_str(),
+                   kStoreHeaderName);
+  const std::vector<int> missing = store.missingFrames();
   for (int f : store.frames()) {
+    if (std::binary_search(missing.begin(), missing.end(), f)) continue;  // reported above
     try {
       auto index = store.frame(f);
       frames.push_back(summarizeFrame(*index, h));
@@ -63,6 +82,8 @@ void runInfo(const InfoArgs& a) {
     j["origin"] = {h.origin.x, h.origin.y, h.origin.z};
     j["brick_grid"] = {h.brickGrid.x, h.brickGrid.y, h.brickGrid.z};
     j["attribute"] = attributeName(h.attribute);
+    j["store_id"] = storeIdText(h.id);
+    j["frames_missing"] = missing;
     j["frames"] = nlohmann::json::array();
     for (const auto& s : frames) {
       j["frames"].push_back({{"frame", s.frame},
@@ -87,7 +108,7 @@ void runInfo(const InfoArgs& a) {
     }
     std::printf("%s\n", j.dump(2).c_str());
   } else {
-    std::printf("store      %s (version %u)\n", a.store.c_str(), h.version);
+    std::printf("store      %s (version %u, id %s)\n", a.store.c_str(), h.version, storeIdText(h.id).c_str());
     std::printf("domain     origin (%g, %g, %g), cell size %g, %ux%ux%u bricks of %u^3 cells\n", h.origin.x, h.origin.y,
                 h.origin.z, h.cellSize, h.brickGrid.x, h.brickGrid.y, h.brickGrid.z, h.brickSize);
     if (h.particleSpacing > 0)
@@ -107,11 +128,14 @@ void runInfo(const InfoArgs& a) {
     if (total.skippedInvalid || total.skippedOutside)
       std::printf("skipped at conversion: %llu NaN/Inf, %llu outside the domain\n",
                   (unsigned long long)total.skippedInvalid, (unsigned long long)total.skippedOutside);
-    if (a.verify && damage.empty()) std::printf("verify: every checksum of %zu frames is intact\n", frames.size());
+    if (a.verify && damage.empty())
+      std::printf("verify: the %zu frames %s lists are all present and every checksum is intact\n", frames.size(),
+                  kStoreHeaderName);
   }
   if (!damage.empty()) {
     for (const auto& d : damage) std::fprintf(stderr, "damaged: %s\n", d.c_str());
-    throw CommandFailed("verify: " + std::to_string(damage.size()) + " damaged brick(s) or frame(s) in " + a.store);
+    throw CommandFailed("verify: " + std::to_string(damage.size()) + " damaged or missing brick(s) or frame(s) in " +
+                        a.store);
   }
 }
 

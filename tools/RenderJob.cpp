@@ -28,7 +28,8 @@ std::string outputPathForFrame(const std::string& pattern, int frame) {
 std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
   BrickStore store = BrickStore::open(job.store);
   const std::vector<int> stored = store.frames();
-  if (stored.empty()) throw InputError(job.store + ": the store has no frames");
+  if (stored.empty())
+    throw FileError(job.store, "the store has no complete frame (an interrupted convert? convert again)");
   const int first = job.firstFrame.value_or(stored.front());
   const int last = job.lastFrame.value_or(first);
   if (last < first) throw InputError("--frames: the last frame comes before the first");

@@ -112,7 +112,9 @@ TEST_P(ConvertOracle, StoreMatchesBruteForceBinning) {
   for (std::uint32_t b = 0; b < frame->bricks.size(); ++b) {
     const BrickRecord& r = frame->bricks[b];
     const std::uint32_t code = mortonEncode3(r.coord.x, r.coord.y, r.coord.z);
-    if (b) EXPECT_GT(code, previous);
+    if (b) {
+      EXPECT_GT(code, previous);
+    }
     previous = code;
     EXPECT_EQ(frame->octree.find(r.coord), std::int64_t(b));
     auto it = oracle.find({r.coord.x, r.coord.y, r.coord.z});
@@ -148,7 +150,9 @@ TEST(Convert, OutOfCoreStoreIsByteIdenticalToInCore) {
   auto run = [&](std::uint64_t budget, const std::string& name) {
     options.memoryBudget = budget;
     const fs::path dir = temp / name;
-    BrickStore store = BrickStore::createOrAppend(dir, makeStoreHeader(domain, options, true));
+    StoreHeader header = makeStoreHeader(domain, options, true);
+    header.id = {7, 7, 7};  // the same id for both stores: then the files are the same bytes
+    BrickStore store = BrickStore::createOrAppend(dir, header);
     testing::VectorSource source(positions, velocities);
     FrameReport report = convertFrame(source, store, 1, options);
     return std::make_pair(dir, report);
@@ -178,10 +182,14 @@ TEST(Convert, SkewedDataSplitsBucketsRecursively) {
   for (std::uint64_t budget : {1ull << 30, 2ull << 20}) {
     options.memoryBudget = budget;
     const fs::path dir = temp / std::to_string(budget);
-    BrickStore store = BrickStore::createOrAppend(dir, makeStoreHeader(domain, options, false));
+    StoreHeader header = makeStoreHeader(domain, options, false);
+    header.id = {1, 2, 3};  // the same id for both stores
+    BrickStore store = BrickStore::createOrAppend(dir, header);
     testing::VectorSource source(positions);
     const FrameReport report = convertFrame(source, store, 0, options);
-    if (budget < (1ull << 30)) EXPECT_GT(report.spillBuckets, 4u) << "the overflowing bucket was not split";
+    if (budget < (1ull << 30)) {
+      EXPECT_GT(report.spillBuckets, 4u) << "the overflowing bucket was not split";
+    }
     files.push_back(readFile(dir / "frame_000000.fsf"));
   }
   EXPECT_EQ(files[0], files[1]);

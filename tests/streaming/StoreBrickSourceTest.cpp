@@ -31,7 +31,7 @@ class StoreBrickSourceTest : public ::testing::Test {
     std::vector<glm::uvec3> coords = mSynthetic.bricks(1);
     std::sort(coords.begin(), coords.end(),
               [](glm::uvec3 a, glm::uvec3 b) { return mortonEncode3(a.x, a.y, a.z) < mortonEncode3(b.x, b.y, b.z); });
-    FrameWriter writer(store.framePath(1), header, 1);
+    FrameWriter writer(store.framePath(1), store.header(), 1);  // carries the store id
     FrameStats stats;
     for (glm::uvec3 c : coords) {
       auto brick = mSynthetic.read({1, c});

@@ -1,0 +1,171 @@
+// Writes the fuzz seed corpus: small valid inputs for every target (FuzzTargets.h), made by
+// flipscope itself (particle writers, `flipscope synth` and `convert`, encodeBrick, saveCamera),
+// by OpenVDB in every way it writes points (tests/preprocess/VdbTestFiles.h), and the Mantaflow
+// sample. Skipped unless asked:
+//   FLIPSCOPE_WRITE_FUZZ_CORPUS=$PWD/tests/fuzz/corpus build/tests/test_fuzz --gtest_filter=FuzzCorpus.Write
+// FuzzCorpus.EverySeedIsAccepted (FuzzRegressionTest.cpp) then checks the seeds.
+#include <gtest/gtest.h>
+
+#include <zstd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "FuzzTargets.h"
+#include "TestSupport.h"
+#include "preprocess/ParticleWriter.h"
+#include "preprocess/VdbTestFiles.h"
+
+namespace flipscope {
+namespace {
+
+namespace fs = std::filesystem;
+
+void writeSeed(const fs::path& path, std::span<const std::byte> bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+  ASSERT_TRUE(out.good()) << path;
+}
+void writeSeed(const fs::path& path, const std::string& text) {
+  writeSeed(path, std::as_bytes(std::span(text.data(), text.size())));
+}
+std::vector<std::byte> bytesOf(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto bytes = std::as_bytes(std::span(text.data(), text.size()));
+  return {bytes.begin(), bytes.end()};
+}
+
+/// `count` particles in [0, 1)^3, velocities in [-2, 2)^3, seeded.
+ParticleChunk particles(std::size_t count, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> unit(0.f, 1.f), speed(-2.f, 2.f);
+  ParticleChunk chunk;
+  for (std::size_t i = 0; i < count; ++i) {
+    chunk.positions.emplace_back(unit(rng), unit(rng), unit(rng));
+    chunk.velocities.emplace_back(speed(rng), speed(rng), speed(rng));
+  }
+  return chunk;
+}
+
+void writeParticles(const fs::path& path, const ParticleChunk& chunk, const WriteOptions& options) {
+  auto writer = createParticleWriter(path, options);
+  ParticleChunk copy = chunk;
+  if (!options.velocity) copy.velocities.clear();
+  writer->write(copy);
+  writer->commit();
+}
+
+TEST(FuzzCorpus, Write) {
+  const char* out = std::getenv("FLIPSCOPE_WRITE_FUZZ_CORPUS");
+  if (!out) GTEST_SKIP() << "set FLIPSCOPE_WRITE_FUZZ_CORPUS to the corpus folder to write it";
+  const fs::path corpus = out;
+  for (const fuzz::Target& target : fuzz::kTargets) {
+    fs::remove_all(corpus / target.name);
+    fs::create_directories(corpus / target.name);
+  }
+  testing::TempDir tmp("fuzz-corpus");
+
+  // Particle files.
+  for (bool velocity : {false, true}) {
+    WriteOptions options;
+    options.velocity = velocity;
+    const std::string v = velocity ? "_v" : "";
+    for (auto [encoding, name] : {std::pair{PlyEncoding::Ascii, "ascii"},
+                                  {PlyEncoding::BinaryLittleEndian, "le"},
+                                  {PlyEncoding::BinaryBigEndian, "be"}}) {
+      options.plyEncoding = encoding;
+      writeParticles(corpus / "ply" / (std::string(name) + v + ".ply"), particles(40, 1), options);
+    }
+    writeParticles(corpus / "vdb_points" / ("flipscope" + v + ".vdb"), particles(60, 2), options);
+  }
+  writeParticles(corpus / "raw" / "particles.bin", particles(80, 3), WriteOptions{});
+  writeSeed(corpus / "raw" / "one.bin", std::string(12, '\0'));
+  writeSeed(corpus / "ply" / "types.ply",
+            "ply\nformat ascii 1.0\ncomment every scalar type\nelement vertex 3\nproperty double x\n"
+            "property int y\nproperty uchar z\nproperty short nx\nproperty float vx\nproperty float vy\n"
+            "property float vz\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+            "0.5 1 2 -3 0.25 1e-3 -7\n-1e30 -2147483648 255 32767 0 0 0\n+3.25 0 0 0 1 2 3\n3 0 1 2\n");
+  writeSeed(corpus / "ply" / "double_be.ply",
+            std::string("ply\nformat binary_big_endian 1.0\nelement vertex 1\nproperty double x\nproperty double y\n"
+                        "property double z\nend_header\n") +
+                std::string("\x3f\xf0\0\0\0\0\0\0\x40\0\0\0\0\0\0\0\xc0\x08\0\0\0\0\0\0", 24));
+
+  // OpenVDB files: every codec, compression and layout (compact: a few KB each), and Mantaflow.
+  // (Not the uncompressed ones: 158 KB of internal node values, and libFuzzer's -max_len follows
+  // the largest seed.)
+  for (const auto& file : testing::vdbTestFiles(tmp.path(), 0.02, false, true))
+    if (fs::file_size(file.path) < 64 * 1024) fs::copy_file(file.path, corpus / "vdb_points" / file.path.filename());
+  const fs::path mantaflow = fs::path(FLIPSCOPE_DATA_DIR) / "mantaflow-dam64" / "particles";
+  for (const char* name : {"fluid_particles_0001.vdb", "fluid_particles_0002.vdb"})
+    fs::copy_file(mantaflow / name, corpus / "vdb_points" / ("mantaflow_" + std::string(name)));
+
+  // Stores: flipscope synth and convert, with and without the speed attribute, two brick sizes.
+  ASSERT_EQ(testing::runFlipscope("synth -o s.ply --particles 1k --velocity", tmp.path()).exitCode, 0);
+  struct Store {
+    const char* name;
+    const char* options;
+  };
+  for (const Store& store : {Store{"speed32", "--resolution 24 --brick-size 32"},
+                             Store{"none64", "--resolution 48 --brick-size 64 --attribute none"}}) {
+    const auto run =
+        testing::runFlipscope(std::string("convert s.ply -o ") + store.name + " -q " + store.options, tmp.path());
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    const auto header = bytesOf(tmp / store.name / kStoreHeaderName);
+    writeSeed(corpus / "store_header" / (std::string(store.name) + ".fsh"), header);
+    for (const auto& entry : fs::directory_iterator(tmp / store.name)) {
+      if (entry.path().extension() != ".fsf") continue;
+      const auto frame = bytesOf(entry.path());
+      std::vector<std::byte> seed(4);
+      const auto length = std::uint32_t(header.size());
+      std::memcpy(seed.data(), &length, 4);
+      seed.insert(seed.end(), header.begin(), header.end());
+      seed.insert(seed.end(), frame.begin(), frame.end());
+      writeSeed(corpus / "frame_index" / (std::string(store.name) + ".seed"), seed);
+    }
+  }
+
+  // Brick payloads: random bricks of each size, with and without attributes, in both forms.
+  std::mt19937 rng(7);
+  for (std::uint32_t sizeIndex = 0; sizeIndex < 3; ++sizeIndex)
+    for (bool attribute : {false, true}) {
+      const std::uint32_t brickSize = 32u << sizeIndex, cells = brickSize * brickSize * brickSize;
+      DecodedBrick brick;
+      for (std::uint32_t cell = std::uint32_t(rng() % 50); cell < cells; cell += 1 + std::uint32_t(rng() % 3000)) {
+        brick.cells.push_back(cell);
+        brick.counts.push_back(1 + std::uint32_t(rng() % (sizeIndex == 0 ? 200 : 9)));
+        for (std::uint32_t i = 0; attribute && i < brick.counts.back(); ++i)
+          brick.attributes.push_back(std::uint16_t(rng()));
+      }
+      const std::vector<std::byte> payload = encodeBrick(brick, 3);
+      for (bool rawForm : {false, true}) {
+        std::vector<std::byte> body = payload;
+        if (rawForm) {
+          body.resize(ZSTD_getFrameContentSize(payload.data(), payload.size()));
+          ASSERT_EQ(ZSTD_decompress(body.data(), body.size(), payload.data(), payload.size()), body.size());
+        }
+        std::vector<std::byte> seed(9);
+        const auto particles = std::uint32_t(brick.particleCount()), occupied = std::uint32_t(brick.cells.size());
+        std::memcpy(seed.data(), &particles, 4);
+        std::memcpy(seed.data() + 4, &occupied, 4);
+        seed[8] = std::byte(std::uint8_t((attribute ? 1 : 0) | sizeIndex << 1 | (rawForm ? 8 : 0)));
+        seed.insert(seed.end(), body.begin(), body.end());
+        writeSeed(
+            corpus / "brick_payload" /
+                ("b" + std::to_string(brickSize) + (attribute ? "_speed" : "") + (rawForm ? "_raw" : "") + ".seed"),
+            seed);
+      }
+    }
+
+  // Cameras.
+  saveCamera(corpus / "camera" / "full.json", Camera{{2, 1.5, 3}, {0.5, 0.2, 0.5}, {0, 1, 0}, 35});
+  saveCamera(corpus / "camera" / "z_up.json", Camera{{-4e3, 2e-3, 10}, {0, 0, 0}, {0, 0, 1}, 90});
+  writeSeed(corpus / "camera" / "minimal.json", std::string(R"({"eye": [0, 0, 5], "target": [0, 0, 0]})"));
+  writeSeed(corpus / "camera" / "spaced.json",
+            std::string("{\n  \"fov\" : 1.5e1 , \"up\":[1,0,0],\n  \"eye\":[-1,-2.5,-3], \"target\":[1e0,2,3]}\n"));
+}
+
+}  // namespace
+}  // namespace flipscope

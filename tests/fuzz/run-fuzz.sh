@@ -1,0 +1,46 @@
+#!/bin/sh
+# Builds the libFuzzer targets (clang, ASan + UBSan, FLIPSCOPE_FUZZ=ON) into BUILD_DIR and runs
+# each for SECONDS from its seed corpus (tests/fuzz/corpus/<target>; new inputs go to
+# BUILD_DIR/fuzz-run, not into the repository). Fails on any crash, leak, timeout (10 s an
+# input) or memory beyond 2 GiB; the input that did it is left in BUILD_DIR/fuzz-run/.
+# CI: tests/fuzz/run-fuzz.sh [build-dir] [seconds]   (defaults build-fuzz, 30)
+# A crasher, once fixed, goes into tests/fuzz/regressions/<target>/ (see FuzzRegressionTest.cpp).
+set -eu
+root=$(cd "$(dirname "$0")/../.." && pwd)
+build=${1:-build-fuzz}
+seconds=${2:-30}
+jobs=${FLIPSCOPE_JOBS:-2}
+CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DFLIPSCOPE_FUZZ=ON -DFLIPSCOPE_BUILD_TESTS=OFF -DFLIPSCOPE_SANITIZE="address;undefined" >/dev/null
+ninja -C "$build" -j"$jobs" flipscope_fuzzers
+work="$build/fuzz-run"
+rm -rf "$work"
+mkdir -p "$work"
+summary=""
+failed=""
+for pair in vdb_points:VdbPoints ply:Ply raw:Raw store_header:StoreHeader frame_index:FrameIndex \
+  brick_payload:BrickPayload camera:Camera; do
+  name=${pair%%:*}
+  binary="$build/tests/fuzz/${pair#*:}Fuzz"
+  mkdir -p "$work/$name"
+  log="$work/$name.log"
+  echo "fuzz: $name for ${seconds} s"
+  if ASAN_OPTIONS="detect_leaks=1:allocator_may_return_null=0" UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
+    "$binary" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+    -artifact_prefix="$work/$name-" "$work/$name" "$root/tests/fuzz/corpus/$name" >"$log" 2>&1; then
+    :
+  else
+    failed="$failed $name"
+    tail -n 60 "$log"
+  fi
+  runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log")
+  rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log")
+  summary="$summary$(printf '%-14s %10s runs %8s/s' "$name" "${runs:-?}" "${rate:-?}")
+"
+done
+printf 'fuzz summary (%s s each):\n%s' "$seconds" "$summary"
+if [ -n "$failed" ]; then
+  echo "fuzz: FAILED:$failed (inputs and logs in $work)"
+  exit 1
+fi
+echo "fuzz: no crash, leak or timeout"
