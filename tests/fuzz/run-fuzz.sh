@@ -1,14 +1,18 @@
 #!/bin/sh
 # Builds the libFuzzer targets (clang, ASan + UBSan, FLIPSCOPE_FUZZ=ON) into BUILD_DIR and runs
-# each for SECONDS from its seed corpus (tests/fuzz/corpus/<target>; new inputs go to
+# each for SECONDS (at most; with RUNS, for exactly that many inputs from the fixed seed 1, so a
+# run is the same on every machine: what CI does) from its seed corpus (tests/fuzz/corpus/<target>; new inputs go to
 # BUILD_DIR/fuzz-run, not into the repository). Fails on any crash, leak, timeout (10 s an
 # input) or memory beyond 2 GiB; the input that did it is left in BUILD_DIR/fuzz-run/.
-# CI: tests/fuzz/run-fuzz.sh [build-dir] [seconds]   (defaults build-fuzz, 30)
+# CI: tests/fuzz/run-fuzz.sh [build-dir] [seconds] [runs]   (defaults build-fuzz, 30, unlimited)
 # A crasher, once fixed, goes into tests/fuzz/regressions/<target>/ (see FuzzRegressionTest.cpp).
 set -eu
 root=$(cd "$(dirname "$0")/../.." && pwd)
 build=${1:-build-fuzz}
 seconds=${2:-30}
+runs_limit=${3:-}
+limit="-max_total_time=$seconds"
+[ -n "$runs_limit" ] && limit="-runs=$runs_limit -seed=1 -max_total_time=$((seconds * 4))"
 jobs=${FLIPSCOPE_JOBS:-2}
 CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DFLIPSCOPE_FUZZ=ON -DFLIPSCOPE_BUILD_TESTS=OFF -DFLIPSCOPE_SANITIZE="address;undefined" >/dev/null
@@ -26,7 +30,7 @@ for pair in vdb_points:VdbPoints ply:Ply raw:Raw store_header:StoreHeader frame_
   log="$work/$name.log"
   echo "fuzz: $name for ${seconds} s"
   if ASAN_OPTIONS="detect_leaks=1:allocator_may_return_null=0" UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
-    "$binary" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+    "$binary" $limit -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
     -artifact_prefix="$work/$name-" "$work/$name" "$root/tests/fuzz/corpus/$name" >"$log" 2>&1; then
     :
   else
