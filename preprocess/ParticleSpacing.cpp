@@ -1,6 +1,8 @@
 // ParticleSpacing: the metadata and neighbour estimates of the particle spacing (see the header).
 #include "preprocess/ParticleSpacing.h"
 
+#include "preprocess/PointSpanSource.h"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -271,26 +273,6 @@ double medianWithinSample(const Sample& s) {
   return std::numeric_limits<double>::infinity();
 }
 
-/// A ParticleSource over points in memory.
-class SpanSource final : public ParticleSource {
- public:
-  explicit SpanSource(std::span<const glm::vec3> points) : mPoints(points) {}
-  std::string name() const override { return "points in memory"; }
-  bool hasVelocity() const override { return false; }
-  std::optional<std::uint64_t> countHint() const override { return mPoints.size(); }
-  bool read(ParticleChunk& chunk, std::size_t maxParticles) override {
-    chunk.clear();
-    const std::size_t n = std::min(maxParticles, mPoints.size() - mNext);
-    chunk.positions.assign(mPoints.begin() + std::ptrdiff_t(mNext), mPoints.begin() + std::ptrdiff_t(mNext + n));
-    mNext += n;
-    return n > 0;
-  }
-  void rewind() override { mNext = 0; }
-
- private:
-  std::span<const glm::vec3> mPoints;
-  std::size_t mNext = 0;
-};
 
 }  // namespace
 
@@ -346,7 +328,7 @@ SpacingEstimate neighbourSpacing(ParticleSource& source, std::size_t sampleSize,
 }
 
 SpacingEstimate neighbourSpacing(std::span<const glm::vec3> points, std::size_t sampleSize) {
-  SpanSource source(points);
+  PointSpanSource source(points);
   return neighbourSpacing(source, sampleSize);
 }
 

@@ -51,6 +51,7 @@
 #include "gl/EglContext.h"
 #include "pipeline/FramePipeline.h"
 #include "preprocess/Convert.h"
+#include "preprocess/PointSpanSource.h"
 #include "raycast/RaycastTypes.h"
 #include "smoothing/CpuScreenDevice.h"
 #include "smoothing/GpuScreenDevice.h"
@@ -84,26 +85,6 @@ struct BenchSurfaceArgs {
   bool json = false;
 };
 
-/// The particles of the scene, in memory.
-class PointSource : public ParticleSource {
- public:
-  explicit PointSource(std::vector<glm::vec3> points) : mPoints(std::move(points)) {}
-  std::string name() const override { return "bench surface scene"; }
-  bool hasVelocity() const override { return false; }
-  std::optional<std::uint64_t> countHint() const override { return mPoints.size(); }
-  bool read(ParticleChunk& chunk, std::size_t maxParticles) override {
-    chunk.clear();
-    const std::size_t n = std::min(maxParticles, mPoints.size() - mNext);
-    chunk.positions.assign(mPoints.begin() + std::ptrdiff_t(mNext), mPoints.begin() + std::ptrdiff_t(mNext + n));
-    mNext += n;
-    return n > 0;
-  }
-  void rewind() override { mNext = 0; }
-
- private:
-  std::vector<glm::vec3> mPoints;
-  std::size_t mNext = 0;
-};
 
 /// A sphere in front of a rectangle of the plane z = planeZ, in world units; sized so that
 /// `particles` points make one particle per cell^2 of surface.
@@ -371,7 +352,8 @@ void runBenchSurface(const BenchSurfaceArgs& a) {
     options.progress = Progress::Mode::Silent;
     fs::remove_all(storeDir);
     BrickStore store = BrickStore::createOrAppend(storeDir, makeStoreHeader(*options.domain, options, false));
-    PointSource source(scene.sample(20140609));
+    const std::vector<glm::vec3> points = scene.sample(20140609);
+    PointSpanSource source(points, "bench surface scene");
     convertFrame(source, store, 0, options);
   }
 
