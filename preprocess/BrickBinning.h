@@ -17,8 +17,8 @@
 
 #include "core/Box.h"
 #include "core/UninitializedVector.h"
-#include "preprocess/BrickStore.h"
-#include "preprocess/ParticleSource.h"
+#include "preprocess/store/BrickStore.h"
+#include "preprocess/particles/ParticleSource.h"
 
 namespace flipscope::detail {
 

@@ -22,7 +22,7 @@
 #include "core/AtomicFile.h"
 #include "core/Error.h"
 #include "preprocess/BrickBinning.h"
-#include "preprocess/FrameFile.h"
+#include "preprocess/store/FrameFile.h"
 #include "preprocess/ParticleSpacing.h"
 
 namespace flipscope {

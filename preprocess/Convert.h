@@ -48,9 +48,9 @@
 
 #include "core/Box.h"
 #include "core/Progress.h"
-#include "preprocess/BrickStore.h"
-#include "preprocess/InputSequence.h"
-#include "preprocess/ParticleSource.h"
+#include "preprocess/store/BrickStore.h"
+#include "preprocess/particles/InputSequence.h"
+#include "preprocess/particles/ParticleSource.h"
 
 namespace flipscope {
 

@@ -1,7 +1,7 @@
 // ParticleSpacing: the metadata and neighbour estimates of the particle spacing (see the header).
 #include "preprocess/ParticleSpacing.h"
 
-#include "preprocess/PointSpanSource.h"
+#include "preprocess/particles/PointSpanSource.h"
 
 #include <algorithm>
 #include <bit>

@@ -32,7 +32,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/Progress.h"
-#include "preprocess/ParticleSource.h"
+#include "preprocess/particles/ParticleSource.h"
 
 namespace flipscope {
 

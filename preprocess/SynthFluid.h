@@ -21,7 +21,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/Box.h"
-#include "preprocess/ParticleSource.h"
+#include "preprocess/particles/ParticleSource.h"
 
 namespace flipscope {
 

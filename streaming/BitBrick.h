@@ -25,7 +25,7 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
-#include "preprocess/BrickStore.h"
+#include "preprocess/store/BrickStore.h"
 #include "streaming/BitBrickLayout.h"
 
 namespace flipscope {

@@ -17,7 +17,7 @@
 
 #include <glm/vec3.hpp>
 
-#include "preprocess/BrickStore.h"
+#include "preprocess/store/BrickStore.h"
 
 namespace flipscope {
 

@@ -15,7 +15,7 @@
 
 #include "FuzzTargets.h"
 #include "TestSupport.h"
-#include "preprocess/ParticleWriter.h"
+#include "preprocess/particles/ParticleWriter.h"
 #include "preprocess/VdbTestFiles.h"
 
 namespace flipscope {

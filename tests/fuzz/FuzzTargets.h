@@ -30,9 +30,9 @@
 
 #include "core/Error.h"
 #include "core/Hash.h"
-#include "preprocess/BrickStore.h"
-#include "preprocess/FrameFile.h"
-#include "preprocess/ParticleFormats.h"
+#include "preprocess/store/BrickStore.h"
+#include "preprocess/store/FrameFile.h"
+#include "preprocess/particles/ParticleFormats.h"
 #include "raycast/Camera.h"
 
 namespace flipscope::fuzz {

@@ -10,7 +10,7 @@
 
 #include "core/Bytes.h"
 #include "core/Error.h"
-#include "preprocess/BrickStore.h"
+#include "preprocess/store/BrickStore.h"
 
 namespace flipscope {
 namespace {

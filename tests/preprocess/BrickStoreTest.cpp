@@ -11,7 +11,7 @@
 #include "core/Bytes.h"
 #include "core/Error.h"
 #include "core/Hash.h"
-#include "preprocess/BrickStore.h"
+#include "preprocess/store/BrickStore.h"
 #include "preprocess/Convert.h"
 #include "TestSupport.h"
 #include "VectorSource.h"

@@ -13,7 +13,7 @@
 #include "preprocess/BrickBinning.h"
 #include "preprocess/Convert.h"
 #include "preprocess/ParticleSpacing.h"
-#include "preprocess/ParticleWriter.h"
+#include "preprocess/particles/ParticleWriter.h"
 #include "TestSupport.h"
 #include "VectorSource.h"
 

@@ -13,8 +13,8 @@
 #include <string>
 
 #include "core/Error.h"
-#include "preprocess/ParticleSource.h"
-#include "preprocess/ParticleWriter.h"
+#include "preprocess/particles/ParticleSource.h"
+#include "preprocess/particles/ParticleWriter.h"
 #include "TestSupport.h"
 
 namespace flipscope::testing {

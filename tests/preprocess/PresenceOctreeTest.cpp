@@ -7,7 +7,7 @@
 #include <set>
 
 #include "core/Morton.h"
-#include "preprocess/PresenceOctree.h"
+#include "preprocess/store/PresenceOctree.h"
 
 namespace flipscope {
 namespace {

@@ -17,10 +17,10 @@
 #include "core/Bytes.h"
 #include "core/Error.h"
 #include "core/Hash.h"
-#include "preprocess/BrickStore.h"
+#include "preprocess/store/BrickStore.h"
 #include "preprocess/Convert.h"
-#include "preprocess/FrameFile.h"
-#include "preprocess/StoreInspection.h"
+#include "preprocess/store/FrameFile.h"
+#include "preprocess/store/StoreInspection.h"
 #include "TestSupport.h"
 #include "VectorSource.h"
 

@@ -10,7 +10,7 @@
 
 #include "ParticleTestSupport.h"
 #include "VdbTestFiles.h"
-#include "preprocess/ParticleFormats.h"
+#include "preprocess/particles/ParticleFormats.h"
 #include "preprocess/SynthFluid.h"
 
 namespace flipscope {

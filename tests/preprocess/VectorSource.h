@@ -5,7 +5,7 @@
 
 #include <glm/common.hpp>
 
-#include "preprocess/ParticleSource.h"
+#include "preprocess/particles/ParticleSource.h"
 
 namespace flipscope::testing {
 

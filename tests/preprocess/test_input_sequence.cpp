@@ -2,7 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "ParticleTestSupport.h"
-#include "preprocess/InputSequence.h"
+#include "preprocess/particles/InputSequence.h"
 
 namespace flipscope {
 namespace {

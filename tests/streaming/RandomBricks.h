@@ -4,7 +4,7 @@
 
 #include <random>
 
-#include "preprocess/BrickStore.h"
+#include "preprocess/store/BrickStore.h"
 
 namespace flipscope::testing {
 

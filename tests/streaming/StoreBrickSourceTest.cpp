@@ -8,7 +8,7 @@
 
 #include "core/Error.h"
 #include "core/Morton.h"
-#include "preprocess/FrameFile.h"
+#include "preprocess/store/FrameFile.h"
 #include "streaming/Streamer.h"
 #include "streaming/SyntheticBrickSource.h"
 

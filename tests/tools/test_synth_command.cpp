@@ -10,7 +10,7 @@
 #include <sstream>
 #include <string>
 
-#include "preprocess/ParticleSource.h"
+#include "preprocess/particles/ParticleSource.h"
 #include "preprocess/SynthFluid.h"
 #include "TestSupport.h"
 

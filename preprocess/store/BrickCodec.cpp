@@ -11,7 +11,7 @@
 #include <algorithm>
 
 #include "core/Bytes.h"
-#include "preprocess/BrickStore.h"
+#include "preprocess/store/BrickStore.h"
 
 namespace flipscope {
 

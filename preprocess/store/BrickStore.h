@@ -39,7 +39,7 @@
 
 #include <glm/vec3.hpp>
 
-#include "preprocess/PresenceOctree.h"
+#include "preprocess/store/PresenceOctree.h"
 
 namespace flipscope {
 

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "preprocess/BrickStore.h"
+#include "preprocess/store/BrickStore.h"
 
 namespace flipscope {
 

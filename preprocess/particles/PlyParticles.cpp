@@ -12,8 +12,8 @@
 
 #include "core/AtomicFile.h"
 #include "core/Error.h"
-#include "preprocess/InputFile.h"
-#include "preprocess/ParticleFormats.h"
+#include "preprocess/particles/InputFile.h"
+#include "preprocess/particles/ParticleFormats.h"
 
 namespace flipscope::detail {
 namespace {

@@ -1,6 +1,6 @@
 // Frame patterns of `flipscope convert` inputs: `####` (zero padded to the run's width),
 // printf `%d` / `%0Nd`, and `{}`; expansion into frames from a range or the directory listing.
-#include "preprocess/InputSequence.h"
+#include "preprocess/particles/InputSequence.h"
 
 #include <algorithm>
 #include <charconv>

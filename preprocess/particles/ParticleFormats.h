@@ -8,9 +8,9 @@
 #include <memory>
 #include <span>
 
-#include "preprocess/InputFile.h"
-#include "preprocess/ParticleSource.h"
-#include "preprocess/ParticleWriter.h"
+#include "preprocess/particles/InputFile.h"
+#include "preprocess/particles/ParticleSource.h"
+#include "preprocess/particles/ParticleWriter.h"
 
 namespace flipscope::detail {
 

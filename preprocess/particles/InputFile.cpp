@@ -1,4 +1,4 @@
-#include "preprocess/InputFile.h"
+#include "preprocess/particles/InputFile.h"
 
 #include <algorithm>
 #include <cerrno>

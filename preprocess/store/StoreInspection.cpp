@@ -1,4 +1,4 @@
-#include "preprocess/StoreInspection.h"
+#include "preprocess/store/StoreInspection.h"
 
 #include <tbb/parallel_for.h>
 

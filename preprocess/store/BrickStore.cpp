@@ -1,5 +1,5 @@
 // BrickStore: store header, frame files and brick reads (format in BrickStore.h, FrameFile.h).
-#include "preprocess/BrickStore.h"
+#include "preprocess/store/BrickStore.h"
 
 #include <fcntl.h>
 #include <sys/random.h>
@@ -16,7 +16,7 @@
 #include "core/Bytes.h"
 #include "core/Hash.h"
 #include "core/Morton.h"
-#include "preprocess/FrameFile.h"
+#include "preprocess/store/FrameFile.h"
 
 namespace flipscope {
 namespace {

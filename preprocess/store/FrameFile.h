@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "core/AtomicFile.h"
-#include "preprocess/BrickStore.h"
+#include "preprocess/store/BrickStore.h"
 
 namespace flipscope {
 

@@ -11,7 +11,7 @@
 #include <filesystem>
 #include <memory>
 
-#include "preprocess/ParticleSource.h"
+#include "preprocess/particles/ParticleSource.h"
 
 namespace flipscope {
 

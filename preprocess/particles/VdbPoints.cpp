@@ -13,7 +13,7 @@
 
 #include "core/AtomicFile.h"
 #include "core/Error.h"
-#include "preprocess/ParticleFormats.h"
+#include "preprocess/particles/ParticleFormats.h"
 
 namespace flipscope::detail {
 namespace {

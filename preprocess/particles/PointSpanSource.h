@@ -11,7 +11,7 @@
 
 #include <glm/vec3.hpp>
 
-#include "preprocess/ParticleSource.h"
+#include "preprocess/particles/ParticleSource.h"
 
 namespace flipscope {
 

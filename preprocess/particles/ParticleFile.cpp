@@ -4,9 +4,9 @@
 #include <cctype>
 
 #include "core/Error.h"
-#include "preprocess/ParticleFormats.h"
-#include "preprocess/ParticleSource.h"
-#include "preprocess/ParticleWriter.h"
+#include "preprocess/particles/ParticleFormats.h"
+#include "preprocess/particles/ParticleSource.h"
+#include "preprocess/particles/ParticleWriter.h"
 
 namespace flipscope {
 namespace {

@@ -35,7 +35,7 @@
 #include <sstream>
 
 #include "core/Error.h"
-#include "preprocess/ParticleFormats.h"
+#include "preprocess/particles/ParticleFormats.h"
 
 namespace flipscope::detail {
 namespace {

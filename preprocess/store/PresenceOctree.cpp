@@ -1,5 +1,5 @@
 // Presence octree construction over Morton-sorted bricks (Reichl et al. 2014 §3, Fig. 2).
-#include "preprocess/PresenceOctree.h"
+#include "preprocess/store/PresenceOctree.h"
 
 #include <bit>
 
