@@ -42,6 +42,7 @@ class SynthFluid : public ParticleSource {
   explicit SynthFluid(const SynthOptions& options);
 
   std::string name() const override;
+  std::string format() const override { return "flipscope synthetic fluid"; }
   bool hasVelocity() const override { return mOptions.velocity; }
   std::optional<std::uint64_t> countHint() const override { return count(); }
   bool read(ParticleChunk& chunk, std::size_t maxParticles) override;

@@ -1,88 +1,158 @@
 #include "preprocess/particles/InputFile.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <utility>
 
 #include "core/Error.h"
 
 namespace flipscope {
+namespace {
 
-InputFile::InputFile(std::filesystem::path path) : mPath(std::move(path)) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(mPath, ec)) throw FileError(mPath, "is a directory, expected a particle file");
-  mFile = std::fopen(mPath.c_str(), "rb");
-  if (!mFile) throw FileError(mPath, std::string("cannot open: ") + std::strerror(errno));
-  std::setvbuf(mFile, nullptr, _IOFBF, 1 << 20);
-  mSize = std::filesystem::file_size(mPath, ec);
-  if (ec) {
-    std::fclose(mFile);
-    throw FileError(mPath, "cannot read the file size: " + ec.message());
+constexpr std::size_t kBufferBytes = std::size_t(1) << 20;
+
+class FileByteSource final : public ByteSource {
+ public:
+  explicit FileByteSource(const std::filesystem::path& path) : mPath(path) {
+    std::error_code ec;
+    auto status = std::filesystem::status(path, ec);
+    if (!std::filesystem::exists(status)) throw FileError(path, "no such file");
+    if (std::filesystem::is_directory(status)) throw FileError(path, "is a directory, expected a particle file");
+    if (!std::filesystem::is_regular_file(status))
+      throw FileError(path, "is not a regular file (a device, pipe or socket), expected a particle file");
+    mFd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (mFd < 0) throw FileError(path, std::string("cannot open: ") + std::strerror(errno));
+    mSize = std::filesystem::file_size(path, ec);
+    if (ec) {
+      ::close(mFd);
+      throw FileError(path, "cannot read the file size: " + ec.message());
+    }
+    ::posix_fadvise(mFd, 0, 0, POSIX_FADV_SEQUENTIAL);
   }
-}
+  ~FileByteSource() override { ::close(mFd); }
+  std::uint64_t size() const override { return mSize; }
+  std::size_t readAt(std::uint64_t offset, void* data, std::size_t bytes) override {
+    std::size_t done = 0;
+    while (done < bytes) {
+      ssize_t n = ::pread(mFd, static_cast<char*>(data) + done, bytes - done, off_t(offset + done));
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0)
+        throw FileError(mPath, "read failed at byte " + std::to_string(offset + done) + ": " + std::strerror(errno));
+      if (n == 0) break;
+      done += std::size_t(n);
+    }
+    return done;
+  }
+
+ private:
+  std::filesystem::path mPath;
+  int mFd = -1;
+  std::uint64_t mSize = 0;
+};
+
+class MemoryByteSource final : public ByteSource {
+ public:
+  explicit MemoryByteSource(std::span<const std::byte> bytes) : mBytes(bytes) {}
+  std::uint64_t size() const override { return mBytes.size(); }
+  std::size_t readAt(std::uint64_t offset, void* data, std::size_t bytes) override {
+    if (offset >= mBytes.size()) return 0;
+    std::size_t n = std::min<std::size_t>(bytes, std::size_t(mBytes.size() - offset));
+    if (n) std::memcpy(data, mBytes.data() + offset, n);
+    return n;
+  }
+
+ private:
+  std::span<const std::byte> mBytes;
+};
+
+}  // namespace
+
+InputFile::InputFile(std::filesystem::path path)
+    : InputFile(path, std::make_unique<FileByteSource>(path)) {}
 
 InputFile::InputFile(std::filesystem::path name, std::span<const std::byte> bytes)
-    : mPath(std::move(name)), mMemory(bytes), mSize(bytes.size()) {}
+    : InputFile(std::move(name), std::make_unique<MemoryByteSource>(bytes)) {}
 
-InputFile::InputFile(InputFile&& other) noexcept
-    : mPath(std::move(other.mPath)),
-      mFile(std::exchange(other.mFile, nullptr)),
-      mMemory(other.mMemory),
-      mSize(other.mSize),
-      mOffset(other.mOffset),
-      mLineTerminated(other.mLineTerminated) {}
+InputFile::InputFile(std::filesystem::path name, std::unique_ptr<ByteSource> source)
+    : mPath(std::move(name)), mSource(std::move(source)), mSize(mSource->size()) {}
 
-InputFile::~InputFile() {
-  if (mFile) std::fclose(mFile);
-}
+InputFile::InputFile(InputFile&& other) noexcept = default;
+InputFile& InputFile::operator=(InputFile&& other) noexcept = default;
+InputFile::~InputFile() = default;
 
 void InputFile::seek(std::uint64_t offset) {
-  if (!mFile) {
-    if (offset > mSize) throw FileError(mPath, "cannot seek to byte " + std::to_string(offset) + ": past the end");
-    mOffset = offset;
-    return;
-  }
-  if (::fseeko(mFile, static_cast<off_t>(offset), SEEK_SET) != 0)
-    throw FileError(mPath, "cannot seek to byte " + std::to_string(offset) + ": " + std::strerror(errno));
+  if (offset > mSize) throw FileError(mPath, "cannot seek to byte " + std::to_string(offset) + ": past the end");
   mOffset = offset;
 }
 
-std::size_t InputFile::read(void* data, std::size_t bytes) {
-  if (!mFile) {
-    const std::size_t n = std::size_t(std::min<std::uint64_t>(bytes, mSize - mOffset));
-    if (n) std::memcpy(data, mMemory.data() + mOffset, n);
-    mOffset += n;
-    return n;
-  }
-  std::size_t n = std::fread(data, 1, bytes, mFile);
-  if (n < bytes && std::ferror(mFile))
-    throw FileError(mPath, "read failed at byte " + std::to_string(mOffset + n) + ": " + std::strerror(errno));
-  mOffset += n;
-  return n;
+bool InputFile::fill() {
+  if (mOffset >= mBufferStart && mOffset < mBufferStart + mBuffer.size()) return true;
+  if (mOffset >= mSize) return false;
+  mBuffer.resize(kBufferBytes);
+  mBufferStart = mOffset;
+  mBuffer.resize(mSource->readAt(mOffset, mBuffer.data(), mBuffer.size()));
+  return !mBuffer.empty();
 }
 
-int InputFile::get() {
-  if (!mFile) return mOffset < mSize ? static_cast<int>(static_cast<unsigned char>(mMemory[mOffset])) : EOF;
-  int c = getc_unlocked(mFile);
-  if (c == EOF && std::ferror(mFile)) throw FileError(mPath, "read failed at byte " + std::to_string(mOffset));
-  return c;
+std::size_t InputFile::read(void* data, std::size_t bytes) {
+  auto* out = static_cast<std::byte*>(data);
+  std::size_t done = 0;
+  while (done < bytes) {
+    if (!(mOffset >= mBufferStart && mOffset < mBufferStart + mBuffer.size()) && bytes - done >= kBufferBytes) {
+      std::size_t n = mSource->readAt(mOffset, out + done, bytes - done);  // large reads skip the buffer
+      mOffset += n;
+      done += n;
+      break;
+    }
+    if (!fill()) break;
+    std::size_t at = std::size_t(mOffset - mBufferStart);
+    std::size_t n = std::min(bytes - done, mBuffer.size() - at);
+    std::memcpy(out + done, mBuffer.data() + at, n);
+    mOffset += n;
+    done += n;
+  }
+  return done;
+}
+
+void InputFile::readExact(void* data, std::size_t bytes, const char* what) {
+  std::uint64_t at = mOffset;
+  if (read(data, bytes) != bytes)
+    throw FileError(mPath, std::string("truncated: the file ends inside ") + what + " (" + std::to_string(bytes) +
+                               " bytes at byte " + std::to_string(at) + ", file size " + std::to_string(mSize) + ")");
+}
+
+std::vector<std::byte> InputFile::peekHead(std::size_t bytes) {
+  std::vector<std::byte> head(std::min<std::uint64_t>(bytes, mSize));
+  head.resize(mSource->readAt(0, head.data(), head.size()));
+  return head;
 }
 
 bool InputFile::readLine(std::string& line, std::size_t maxLength) {
   line.clear();
   mLineTerminated = false;
   for (;;) {
-    int c = get();
-    if (c == EOF) {
+    if (!fill()) {
       if (!line.empty() && line.back() == '\r') line.pop_back();
       return !line.empty();
     }
-    ++mOffset;
-    if (c == '\n') break;
-    if (line.size() == maxLength)
-      throw FileError(mPath, "line at byte " + std::to_string(mOffset - line.size() - 1) + " is longer than " +
+    const std::size_t at = std::size_t(mOffset - mBufferStart);
+    const auto* begin = reinterpret_cast<const char*>(mBuffer.data()) + at;
+    const auto* end = reinterpret_cast<const char*>(mBuffer.data()) + mBuffer.size();
+    const auto* newline = static_cast<const char*>(std::memchr(begin, '\n', std::size_t(end - begin)));
+    const auto* stop = newline ? newline : end;
+    if (line.size() + std::size_t(stop - begin) > maxLength)
+      throw FileError(mPath, "line at byte " + std::to_string(mOffset - line.size()) + " is longer than " +
                                  std::to_string(maxLength) + " bytes");
-    line.push_back(static_cast<char>(c));
+    line.append(begin, stop);
+    mOffset += std::uint64_t(stop - begin);
+    if (newline) {
+      ++mOffset;
+      break;
+    }
   }
   mLineTerminated = true;
   if (!line.empty() && line.back() == '\r') line.pop_back();

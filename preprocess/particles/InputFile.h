@@ -1,52 +1,79 @@
-// InputFile: a read-only file read through a large buffer, for the streaming particle readers
-// (raw, PLY), or bytes in memory read the same way (fuzz targets, tests). Tracks the byte
-// offset for error messages. Not thread safe.
+// InputFile: a read-only byte stream for the particle readers, read through a 1 MiB buffer,
+// from a file, from bytes in memory (fuzz targets, tests) or from a decoder layered over
+// another InputFile (gzip, Houdini's scf1 container: see ByteSource). Tracks the byte offset
+// for error messages. Not thread safe.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
-#include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <span>
 #include <string>
-#include <utility>
+#include <vector>
 
 namespace flipscope {
 
+/// Where an InputFile's bytes come from. Implementations: a file (pread), memory, and the
+/// decoders of compressed containers, which present the decoded bytes.
+class ByteSource {
+ public:
+  virtual ~ByteSource() = default;
+  /// Total size in bytes (a decoder: of the decoded stream, known when it is constructed).
+  virtual std::uint64_t size() const = 0;
+  /// Reads up to `bytes` bytes at `offset` into `data`; returns how many were read (fewer only
+  /// at the end). Reads that follow each other are the fast path; a decoder may have to
+  /// decode again from its start, or from the last index point, to go back. Throws FileError
+  /// on I/O errors and on damaged compressed data.
+  virtual std::size_t readAt(std::uint64_t offset, void* data, std::size_t bytes) = 0;
+};
+
 class InputFile {
  public:
-  /// Opens `path` for reading. Throws FileError when it is missing or unreadable.
+  /// Opens `path` for reading. Throws FileError when it is missing, a directory or unreadable.
   explicit InputFile(std::filesystem::path path);
   /// Reads `bytes` (which must outlive this object) as if they were the file `name`.
   InputFile(std::filesystem::path name, std::span<const std::byte> bytes);
+  /// Reads what `source` presents, named `name` in messages (e.g. "shot.0001.bgeo.sc").
+  InputFile(std::filesystem::path name, std::unique_ptr<ByteSource> source);
   ~InputFile();
   InputFile(InputFile&& other) noexcept;
+  InputFile& operator=(InputFile&& other) noexcept;
   InputFile(const InputFile&) = delete;
   InputFile& operator=(const InputFile&) = delete;
 
   const std::filesystem::path& path() const { return mPath; }
-  /// File size in bytes at open time.
+  /// Size in bytes at open time (of the decoded bytes, for a decoder).
   std::uint64_t size() const { return mSize; }
   /// Byte offset of the next read.
   std::uint64_t offset() const { return mOffset; }
+  /// Throws FileError past the end.
   void seek(std::uint64_t offset);
   /// Reads up to `bytes` bytes; returns how many were read (fewer only at the end of the file).
   /// Throws FileError on an I/O error.
   std::size_t read(void* data, std::size_t bytes);
+  /// Reads exactly `bytes` bytes, or throws FileError saying that the file ends inside `what`.
+  void readExact(void* data, std::size_t bytes, const char* what);
   /// Reads one line without its "\n" (and "\r"). Returns false at the end of the file.
   /// Throws FileError for a line longer than `maxLength` bytes.
   bool readLine(std::string& line, std::size_t maxLength);
   /// Whether the line readLine() returned last ended with "\n" (false: the file ended inside it).
   bool lineTerminated() const { return mLineTerminated; }
+  /// Unbuffered random access (readers that seek, e.g. OpenVDB's pages): ByteSource::readAt.
+  std::size_t readAt(std::uint64_t offset, void* data, std::size_t bytes) { return mSource->readAt(offset, data, bytes); }
+  /// Up to `bytes` bytes from the start of the file, without moving the offset (format
+  /// detection by magic bytes).
+  std::vector<std::byte> peekHead(std::size_t bytes);
 
  private:
-  int get();  ///< next byte, or EOF
+  bool fill();  ///< refills the buffer at mOffset; false at the end
 
   std::filesystem::path mPath;
-  std::FILE* mFile = nullptr;  ///< null when reading from memory
-  std::span<const std::byte> mMemory;
+  std::unique_ptr<ByteSource> mSource;
   std::uint64_t mSize = 0;
   std::uint64_t mOffset = 0;
+  std::vector<std::byte> mBuffer;  ///< bytes [mBufferStart, mBufferStart + mBuffer.size()) of the source
+  std::uint64_t mBufferStart = 0;
   bool mLineTerminated = false;
 };
 

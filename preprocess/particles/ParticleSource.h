@@ -9,20 +9,46 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
 namespace flipscope {
 
+/// The type of one component of an attribute, as the file stores it.
+enum class ValueType : std::uint8_t { Int8, UInt8, Int16, UInt16, Int32, UInt32, Int64, UInt64, Float16, Float32, Float64 };
+/// "int8", "uint8", ..., "float16", "float32", "float64".
+std::string_view valueTypeName(ValueType type);
+
+/// A per-particle attribute that a file holds besides the positions (velocity included), as
+/// its header declares it: what `flipscope inspect` lists and `convert --attribute` chooses.
+struct AttributeDesc {
+  std::string name;  ///< as the file names it: "v", "pscale", "Cd", "Velocity", "id"
+  ValueType type = ValueType::Float32;
+  int arity = 1;  ///< components per particle (3 for a vector)
+  bool operator==(const AttributeDesc&) const = default;
+};
+
+/// The values of one attribute for the particles of a chunk: `arity` components a particle,
+/// converted to float, particle after particle (values.size() == chunk.size() * arity).
+struct AttributeColumn {
+  std::string name;
+  int arity = 1;
+  std::vector<float> values;
+};
+
 /// One chunk of particles in world units. `velocities` is empty when the source has none,
-/// otherwise it has the size of `positions`.
+/// otherwise it has the size of `positions`. `attributes` holds the columns ReadOptions asked
+/// for, in the order asked (ReadOptions::attributes, or attributes() for allAttributes).
 struct ParticleChunk {
   std::vector<glm::vec3> positions;
   std::vector<glm::vec3> velocities;
+  std::vector<AttributeColumn> attributes;
   void clear() {
     positions.clear();
     velocities.clear();
+    for (auto& column : attributes) column.values.clear();
   }
   std::size_t size() const { return positions.size(); }
 };
@@ -41,6 +67,11 @@ class ParticleSource {
   virtual ~ParticleSource() = default;
   /// What error messages call this source (usually the file path).
   virtual std::string name() const = 0;
+  /// The format and its version as the file states it, for `inspect` (e.g. "Houdini binary
+  /// JSON geometry (.bgeo), Houdini 18.5.408").
+  virtual std::string format() const = 0;
+  /// Every per-particle attribute besides the positions, from the header (no data is read).
+  virtual std::vector<AttributeDesc> attributes() const { return {}; }
   /// Whether chunks carry velocities (and want them: see ReadOptions::velocity).
   virtual bool hasVelocity() const = 0;
   /// Total particle count when known without reading the data (file headers), else nullopt.
@@ -60,14 +91,19 @@ struct ReadOptions {
   /// VDB: names of the PointDataGrids to read; empty = every PointDataGrid in the file.
   std::vector<std::string> grids;
   /// Read velocities when the file has them (`vx vy vz` in PLY; in VDB the vec3s attribute `v`,
-  /// else Blender Mantaflow's `particles_velocity*`).
+  /// else Blender Mantaflow's `particles_velocity*`; Houdini `v`, Krakatoa `Velocity`, ...).
   bool velocity = true;
+  /// Attributes to read into ParticleChunk::attributes, by name. Opening a source throws
+  /// FileError, naming the file and listing what it holds, when one is not in attributes().
+  std::vector<std::string> attributes;
+  /// Read every attribute of attributes() instead (`inspect`).
+  bool allAttributes = false;
 };
 
-/// Opens a particle file by its extension (case-insensitive): .vdb, .ply, .bin/.raw
-/// (little-endian float32 xyz). Throws FileError for unknown extensions, missing files and bad
-/// headers. Memory stays bounded by the chunk size, except for a VDB file's tree topology and
-/// one leaf's attributes (delayed loading).
+/// Opens a particle file of any format of the registry (ParticleFormatRegistry.h), recognised
+/// by its content (magic bytes, compressed containers opened first), its name as a fallback.
+/// Throws FileError for unknown formats, missing files and bad headers. Memory stays bounded
+/// by the chunk size, except where a format's reader says otherwise.
 std::unique_ptr<ParticleSource> openParticleFile(const std::filesystem::path& path, const ReadOptions& options = {});
 
 /// Reads several sources one after the other as one (e.g. the FLIP and the spray file of one

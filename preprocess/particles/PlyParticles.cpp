@@ -122,6 +122,7 @@ struct PlyProperty {
 /// What the reader needs from the header.
 struct PlyHeader {
   PlyEncoding encoding = PlyEncoding::Ascii;
+  std::string formatName;  ///< as the format line spells it
   std::uint64_t vertexCount = 0;
   std::vector<PlyProperty> vertexProperties;
   std::size_t vertexBytes = 0;  ///< binary record size
@@ -174,6 +175,7 @@ PlyHeader readPlyHeader(InputFile& file) {
         throw fail(lineNumber,
                    "unknown format '" + words[1] + "' (expected ascii, binary_little_endian or binary_big_endian)");
       if (words[2] != "1.0") throw fail(lineNumber, "unknown format version '" + words[2] + "' (expected 1.0)");
+      header.formatName = words[1];
       hasFormat = true;
     } else if (keyword == "element") {
       if (words.size() != 3) throw fail(lineNumber, "expected 'element <name> <count>', found '" + line + "'");
@@ -243,6 +245,7 @@ class PlyReader final : public ParticleSource {
   }
 
   std::string name() const override { return mFile.path().string(); }
+  std::string format() const override { return "PLY " + mHeader.formatName + " 1.0"; }
   bool hasVelocity() const override { return mHasVelocity; }
   std::optional<std::uint64_t> countHint() const override { return mHeader.vertexCount; }
 
@@ -416,6 +419,11 @@ class PlyWriter final : public ParticleWriter {
 };
 
 }  // namespace
+
+bool isPly(std::span<const std::byte> head) {
+  return head.size() >= 4 && std::memcmp(head.data(), "ply", 3) == 0 &&
+         (head[3] == std::byte{'\n'} || head[3] == std::byte{'\r'});
+}
 
 std::unique_ptr<ParticleSource> openPlyParticles(InputFile file, const ReadOptions& options) {
   return std::make_unique<PlyReader>(std::move(file), options);

@@ -20,6 +20,7 @@ class PointSpanSource final : public ParticleSource {
   explicit PointSpanSource(std::span<const glm::vec3> points, std::string name = "points in memory")
       : mPoints(points), mName(std::move(name)) {}
   std::string name() const override { return mName; }
+  std::string format() const override { return "particles in memory"; }
   bool hasVelocity() const override { return false; }
   std::optional<std::uint64_t> countHint() const override { return mPoints.size(); }
   bool read(ParticleChunk& chunk, std::size_t maxParticles) override {

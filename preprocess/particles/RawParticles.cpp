@@ -24,6 +24,7 @@ class RawReader final : public ParticleSource {
     mCount = mFile.size() / kRawParticleBytes;
   }
   std::string name() const override { return mFile.path().string(); }
+  std::string format() const override { return "raw little-endian float32 xyz"; }
   bool hasVelocity() const override { return false; }
   std::optional<std::uint64_t> countHint() const override { return mCount; }
   bool read(ParticleChunk& chunk, std::size_t maxParticles) override {
@@ -65,11 +66,12 @@ class RawWriter final : public ParticleWriter {
 
 }  // namespace
 
-std::unique_ptr<ParticleSource> openRawParticles(InputFile file) {
+std::unique_ptr<ParticleSource> openRawParticles(InputFile file, const ReadOptions& options) {
+  (void)selectAttributes({}, options, file.path());  // raw files hold positions only
   return std::make_unique<RawReader>(std::move(file));
 }
 
-std::unique_ptr<ParticleWriter> createRawWriter(const std::filesystem::path& path) {
+std::unique_ptr<ParticleWriter> createRawWriter(const std::filesystem::path& path, const WriteOptions&) {
   return std::make_unique<RawWriter>(path);
 }
 

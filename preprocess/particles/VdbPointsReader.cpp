@@ -76,54 +76,17 @@ class ByteInput {
   std::uint64_t mSize = 0;
 };
 
-class FileInput final : public ByteInput {
+/// An InputFile's bytes (a file, memory or a decoded container), read where they are needed.
+class InputFileInput final : public ByteInput {
  public:
-  explicit FileInput(const std::filesystem::path& path) : mPath(path) {
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec)) throw FileError(path, "is a directory, expected a particle file");
-    mFd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (mFd < 0) throw FileError(path, std::string("cannot open: ") + std::strerror(errno));
-    struct stat st {};
-    if (::fstat(mFd, &st) != 0) {
-      const int error = errno;
-      ::close(mFd);
-      throw FileError(path, std::string("cannot stat: ") + std::strerror(error));
-    }
-    mSize = std::uint64_t(st.st_size);
-  }
-  ~FileInput() override { ::close(mFd); }
-  FileInput(const FileInput&) = delete;
-  FileInput& operator=(const FileInput&) = delete;
-
+  explicit InputFileInput(InputFile file) : mFile(std::move(file)) { mSize = mFile.size(); }
   void read(std::uint64_t offset, void* out, std::size_t n) override {
-    auto p = static_cast<char*>(out);
-    while (n > 0) {
-      const ssize_t got = ::pread(mFd, p, n, off_t(offset));
-      if (got < 0 && errno == EINTR) continue;
-      if (got < 0)
-        throw FileError(mPath, "read failed at byte " + std::to_string(offset) + ": " + std::strerror(errno));
-      if (got == 0)
-        throw FileError(mPath, "the file ends at byte " + std::to_string(offset) + ", shorter than when it was opened");
-      p += got;
-      offset += std::uint64_t(got);
-      n -= std::size_t(got);
-    }
+    if (mFile.readAt(offset, out, n) != n)
+      throw FileError(mFile.path(), "the file ends at byte " + std::to_string(offset) + ", shorter than when it was opened");
   }
 
  private:
-  std::filesystem::path mPath;
-  int mFd = -1;
-};
-
-class MemoryInput final : public ByteInput {
- public:
-  explicit MemoryInput(std::span<const std::byte> bytes) : mBytes(bytes) { mSize = bytes.size(); }
-  void read(std::uint64_t offset, void* out, std::size_t n) override {
-    if (n) std::memcpy(out, mBytes.data() + offset, n);
-  }
-
- private:
-  std::span<const std::byte> mBytes;
+  InputFile mFile;
 };
 
 /// Sequential, bounds-checked reads for parsing, through a small buffer.
@@ -462,6 +425,8 @@ class VdbParser {
  public:
   VdbParser(ByteInput& input, const std::filesystem::path& path, const ReadOptions& options)
       : mInput(input), mPath(path), mOptions(options), mCursor(input, path) {}
+
+  std::uint32_t version() const { return mVersion; }
 
   std::vector<PointGrid> parse() {
     Cursor& c = mCursor;
@@ -840,7 +805,11 @@ class VdbPointsReader final : public ParticleSource {
  public:
   VdbPointsReader(std::unique_ptr<ByteInput> input, std::filesystem::path path, ReadOptions options)
       : mInput(std::move(input)), mPath(std::move(path)), mOptions(std::move(options)) {
-    guarded([&] { mGrids = VdbParser(*mInput, mPath, mOptions).parse(); });
+    guarded([&] {
+      VdbParser parser(*mInput, mPath, mOptions);
+      mGrids = parser.parse();
+      mFileVersion = parser.version();
+    });
     bool any = false;
     mHasVelocity = mOptions.velocity;
     for (const auto& g : mGrids) {
@@ -855,6 +824,7 @@ class VdbPointsReader final : public ParticleSource {
   }
 
   std::string name() const override { return mPath.string(); }
+  std::string format() const override { return "OpenVDB points, file format " + std::to_string(mFileVersion); }
   bool hasVelocity() const override { return mHasVelocity; }
   std::optional<std::uint64_t> countHint() const override { return mCount; }
   /// Particles per active voxel of the topology (no attribute is read): a FLIP solver's
@@ -1077,19 +1047,22 @@ class VdbPointsReader final : public ParticleSource {
   std::uint32_t mPoint = 0;
   std::array<std::uint32_t, kLeafVoxels> mOffsets{};
   std::vector<Vec3f> mPositions, mVelocities;
+  std::uint32_t mFileVersion = 0;
   CachedPage mPositionPage, mVelocityPage;
   std::vector<std::byte> mRaw, mDecoded, mScratch;
 };
 
 }  // namespace
 
-std::unique_ptr<ParticleSource> openVdbPoints(const std::filesystem::path& path, const ReadOptions& options) {
-  return std::make_unique<VdbPointsReader>(std::make_unique<FileInput>(path), path, options);
+bool isVdb(std::span<const std::byte> head) {
+  // OPENVDB_MAGIC, 0x56444220, as a little-endian int32.
+  constexpr std::array<std::byte, 4> kMagic{std::byte{0x20}, std::byte{0x42}, std::byte{0x44}, std::byte{0x56}};
+  return head.size() >= 4 && std::equal(kMagic.begin(), kMagic.end(), head.begin());
 }
 
-std::unique_ptr<ParticleSource> openVdbPointsBytes(const std::filesystem::path& name, std::span<const std::byte> bytes,
-                                                   const ReadOptions& options) {
-  return std::make_unique<VdbPointsReader>(std::make_unique<MemoryInput>(bytes), name, options);
+std::unique_ptr<ParticleSource> openVdbPoints(InputFile file, const ReadOptions& options) {
+  std::filesystem::path path = file.path();
+  return std::make_unique<VdbPointsReader>(std::make_unique<InputFileInput>(std::move(file)), std::move(path), options);
 }
 
 }  // namespace flipscope::detail

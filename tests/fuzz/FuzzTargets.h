@@ -32,7 +32,7 @@
 #include "core/Hash.h"
 #include "preprocess/store/BrickStore.h"
 #include "preprocess/store/FrameFile.h"
-#include "preprocess/particles/ParticleFormats.h"
+#include "preprocess/particles/ParticleFormatRegistry.h"
 #include "raycast/Camera.h"
 
 namespace flipscope::fuzz {
@@ -49,7 +49,7 @@ struct Target {
 
 inline Result readParticles(const char* name, std::span<const std::byte> input) {
   try {
-    auto source = detail::openParticleBytes(name, input);
+    auto source = openParticleBytes(name, input);
     (void)source->countHint();
     (void)source->spacingHint();
     ParticleChunk chunk;

@@ -10,7 +10,7 @@
 
 #include "ParticleTestSupport.h"
 #include "VdbTestFiles.h"
-#include "preprocess/particles/ParticleFormats.h"
+#include "preprocess/particles/ParticleFormatRegistry.h"
 #include "preprocess/SynthFluid.h"
 
 namespace flipscope {
@@ -29,7 +29,7 @@ struct Outcome {
 /// `name` fails the test (a crash fails it too).
 Outcome readDamaged(const std::string& name, const std::string& bytes, const std::string& what) {
   try {
-    auto source = detail::openParticleBytes(name, std::as_bytes(std::span(bytes.data(), bytes.size())));
+    auto source = openParticleBytes(name, std::as_bytes(std::span(bytes.data(), bytes.size())));
     ParticleChunk chunk;
     while (source->read(chunk, 4096)) {
     }

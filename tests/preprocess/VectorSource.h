@@ -14,6 +14,7 @@ class VectorSource : public ParticleSource {
   VectorSource(std::vector<glm::vec3> positions, std::vector<glm::vec3> velocities = {})
       : mPositions(std::move(positions)), mVelocities(std::move(velocities)) {}
   std::string name() const override { return "memory"; }
+  std::string format() const override { return "particles in memory"; }
   bool hasVelocity() const override { return !mVelocities.empty(); }
   std::optional<std::uint64_t> countHint() const override { return mPositions.size(); }
   bool read(ParticleChunk& chunk, std::size_t maxParticles) override {

@@ -299,7 +299,7 @@ TEST(ParticleSource, DispatchByExtension) {
   EXPECT_TRUE(sameParticles(readFile(dir / "UPPER.PLY"), particles));
   writeBytes(dir / "p.xyz", "1 2 3\n");
   expectFileError([&] { openParticleFile(dir / "p.xyz"); },
-                  {"p.xyz", "unknown particle file extension '.xyz'", ".vdb", ".ply", ".bin", ".raw"});
+                  {"p.xyz", "unknown particle file format", ".vdb", ".ply", ".bin", ".raw"});
   expectFileError([&] { openParticleFile(dir / "missing.ply"); }, {"missing.ply", "no such file"});
 }
 

@@ -1,0 +1,54 @@
+// Attribute names and types shared by every reader (ParticleSource.h, ParticleFormats.h).
+#include <algorithm>
+
+#include "core/Error.h"
+#include "preprocess/particles/ParticleFormats.h"
+#include "preprocess/particles/ParticleSource.h"
+
+namespace flipscope {
+
+std::string_view valueTypeName(ValueType type) {
+  switch (type) {
+    case ValueType::Int8: return "int8";
+    case ValueType::UInt8: return "uint8";
+    case ValueType::Int16: return "int16";
+    case ValueType::UInt16: return "uint16";
+    case ValueType::Int32: return "int32";
+    case ValueType::UInt32: return "uint32";
+    case ValueType::Int64: return "int64";
+    case ValueType::UInt64: return "uint64";
+    case ValueType::Float16: return "float16";
+    case ValueType::Float32: return "float32";
+    case ValueType::Float64: return "float64";
+  }
+  return "unknown";
+}
+
+std::vector<std::size_t> detail::selectAttributes(const std::vector<AttributeDesc>& available, const ReadOptions& options,
+                                                  const std::filesystem::path& file) {
+  std::vector<std::size_t> selected;
+  if (options.allAttributes) {
+    for (std::size_t i = 0; i < available.size(); ++i) selected.push_back(i);
+    return selected;
+  }
+  for (const auto& name : options.attributes) {
+    auto found = std::find_if(available.begin(), available.end(), [&](const AttributeDesc& a) { return a.name == name; });
+    if (found == available.end()) {
+      std::string names;
+      for (const auto& a : available) names += (names.empty() ? "" : ", ") + a.name;
+      throw FileError(file, "has no attribute '" + name + "' (" +
+                                (names.empty() ? std::string("it holds positions only") : "it holds: " + names) + ")");
+    }
+    selected.push_back(std::size_t(found - available.begin()));
+  }
+  return selected;
+}
+
+std::vector<AttributeColumn> detail::makeColumns(const std::vector<AttributeDesc>& available,
+                                                 const std::vector<std::size_t>& selected) {
+  std::vector<AttributeColumn> columns;
+  for (std::size_t index : selected) columns.push_back({available[index].name, available[index].arity, {}});
+  return columns;
+}
+
+}  // namespace flipscope

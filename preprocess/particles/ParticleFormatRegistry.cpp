@@ -1,0 +1,122 @@
+// The table of particle formats and containers, and recognition by content (see the header).
+#include "preprocess/particles/ParticleFormatRegistry.h"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+
+#include "core/Error.h"
+#include "preprocess/particles/ParticleFormats.h"
+
+namespace flipscope {
+namespace {
+
+constexpr std::size_t kHeadBytes = 64;
+constexpr int kMaxNestedContainers = 2;  // e.g. a gzip around a gzip is refused beyond this
+
+const std::vector<ParticleFormat>& formatTable() {
+  static const std::vector<ParticleFormat> table = {
+      {"vdb", "OpenVDB points (PointDataGrid)", {".vdb"}, detail::isVdb, detail::openVdbPoints, detail::createVdbWriter},
+      {"ply", "PLY polygon file, vertices as points", {".ply"}, detail::isPly, detail::openPlyParticles,
+       detail::createPlyWriter},
+      // No magic: recognised by name only, so it stays last.
+      {"raw", "raw little-endian float32 xyz", {".bin", ".raw"}, nullptr, detail::openRawParticles,
+       detail::createRawWriter},
+  };
+  return table;
+}
+
+const std::vector<ContainerFormat>& containerTable() {
+  static const std::vector<ContainerFormat> table = {};
+  return table;
+}
+
+std::string lowerName(const std::filesystem::path& path) {
+  std::string name = path.filename().string();
+  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return name;
+}
+
+bool endsWith(std::string_view text, std::string_view suffix) {
+  return text.size() >= suffix.size() && text.substr(text.size() - suffix.size()) == suffix;
+}
+
+/// The format whose extension is the longest ending of `name`, or null.
+const ParticleFormat* formatByName(const std::string& name) {
+  const ParticleFormat* best = nullptr;
+  std::size_t bestLength = 0;
+  for (const auto& format : formatTable())
+    for (auto extension : format.extensions)
+      if (endsWith(name, extension) && extension.size() > bestLength) {
+        best = &format;
+        bestLength = extension.size();
+      }
+  return best;
+}
+
+}  // namespace
+
+std::span<const ParticleFormat> particleFormats() { return formatTable(); }
+std::span<const ContainerFormat> containerFormats() { return containerTable(); }
+
+const ParticleFormat* findParticleFormat(std::string_view name) {
+  for (const auto& format : formatTable())
+    if (format.name == name) return &format;
+  return nullptr;
+}
+
+std::string supportedExtensions() {
+  std::string list;
+  for (const auto& format : formatTable())
+    for (auto extension : format.extensions) list += (list.empty() ? "" : ", ") + std::string(extension);
+  return list;
+}
+
+RecognisedInput recogniseInput(InputFile file) {
+  std::vector<std::string> containers;
+  std::string name = lowerName(file.path());
+  for (int depth = 0;; ++depth) {
+    const ContainerFormat* container = nullptr;
+    for (const auto& candidate : containerTable())
+      if (candidate.matches(file)) container = &candidate;
+    if (!container) break;
+    if (depth == kMaxNestedContainers)
+      throw FileError(file.path(), "more than " + std::to_string(kMaxNestedContainers) + " nested compressed containers");
+    containers.emplace_back(container->name);
+    if (endsWith(name, container->extension) && !formatByName(name)) name.resize(name.size() - container->extension.size());
+    std::filesystem::path path = file.path();
+    file = InputFile(path, container->decode(std::move(file)));
+  }
+  const std::vector<std::byte> head = file.peekHead(kHeadBytes);
+  for (const auto& format : formatTable())
+    if (format.matches && format.matches(head)) return {std::move(file), &format, std::move(containers)};
+  // By name: the format's reader then says what is wrong with the file ("bad magic", ...).
+  if (const ParticleFormat* format = formatByName(name)) return {std::move(file), format, std::move(containers)};
+  if (file.size() == 0) throw FileError(file.path(), "is empty (0 bytes), expected a particle file");
+  throw FileError(file.path(), "unknown particle file format (supported: " + supportedExtensions() + ")");
+}
+
+std::unique_ptr<ParticleSource> openParticleFile(const std::filesystem::path& path, const ReadOptions& options) {
+  RecognisedInput input = recogniseInput(InputFile(path));
+  return input.format->open(std::move(input.file), options);
+}
+
+std::unique_ptr<ParticleSource> openParticleBytes(const std::filesystem::path& name, std::span<const std::byte> bytes,
+                                                  const ReadOptions& options) {
+  RecognisedInput input = recogniseInput(InputFile(name, bytes));
+  return input.format->open(std::move(input.file), options);
+}
+
+std::unique_ptr<ParticleWriter> createParticleWriter(const std::filesystem::path& path, const WriteOptions& options) {
+  const ParticleFormat* format = formatByName(lowerName(path));
+  if (!format || !format->create) {
+    std::string writable;
+    for (const auto& f : formatTable())
+      if (f.create)
+        for (auto extension : f.extensions) writable += (writable.empty() ? "" : ", ") + std::string(extension);
+    throw FileError(path, "cannot write this particle format (writable: " + writable + ")");
+  }
+  return format->create(path, options);
+}
+
+}  // namespace flipscope
