@@ -180,7 +180,7 @@ AtomicFile::AtomicFile(std::filesystem::path destination) : mDestination(std::mo
   const DeferCleanupSignals step;          // registered and created as one step
   mCleanup = CleanupOnSignal(mTemporary);
   mFile = std::fopen(mTemporary.c_str(), "wb");
-  if (!mFile) throw FileError(mTemporary, "cannot create temporary file: " + errnoText());
+  if (!mFile) throw OutputError(mTemporary, "cannot create temporary file: " + errnoText());
   std::setvbuf(mFile, nullptr, _IOFBF, 1 << 20);
 }
 
@@ -194,7 +194,7 @@ AtomicFile::~AtomicFile() {
 
 void AtomicFile::write(const void* data, std::size_t bytes) {
   FLIPSCOPE_CHECK(mFile, "write after commit");
-  if (bytes && std::fwrite(data, 1, bytes, mFile) != bytes) throw FileError(mTemporary, "write failed: " + errnoText());
+  if (bytes && std::fwrite(data, 1, bytes, mFile) != bytes) throw OutputError(mTemporary, "write failed: " + errnoText());
   mOffset += bytes;
 }
 
@@ -204,20 +204,20 @@ void AtomicFile::writeAt(std::uint64_t offset, const void* data, std::size_t byt
   if (::fseeko(mFile, static_cast<off_t>(offset), SEEK_SET) != 0 ||
       (bytes && std::fwrite(data, 1, bytes, mFile) != bytes) ||
       ::fseeko(mFile, static_cast<off_t>(mOffset), SEEK_SET) != 0)
-    throw FileError(mTemporary, "write at byte " + std::to_string(offset) + " failed: " + errnoText());
+    throw OutputError(mTemporary, "write at byte " + std::to_string(offset) + " failed: " + errnoText());
 }
 
 void AtomicFile::commit() {
   FLIPSCOPE_CHECK(mFile, "commit twice");
-  if (std::fflush(mFile) != 0) throw FileError(mTemporary, "flush failed: " + errnoText());
-  if (::fsync(::fileno(mFile)) != 0) throw FileError(mTemporary, "fsync failed: " + errnoText());
+  if (std::fflush(mFile) != 0) throw OutputError(mTemporary, "flush failed: " + errnoText());
+  if (::fsync(::fileno(mFile)) != 0) throw OutputError(mTemporary, "fsync failed: " + errnoText());
   std::fclose(mFile);
   mFile = nullptr;
   if (std::rename(mTemporary.c_str(), mDestination.c_str()) != 0) {
     auto reason = errnoText();
     std::error_code ec;
     std::filesystem::remove(mTemporary, ec);
-    throw FileError(mDestination, "cannot rename temporary file into place: " + reason);
+    throw OutputError(mDestination, "cannot rename temporary file into place: " + reason);
   }
   mCleanup.release();  // the temporary name is gone
   auto dir = mDestination.parent_path();

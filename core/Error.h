@@ -18,6 +18,8 @@ inline constexpr int kExitOk = 0;
 inline constexpr int kExitFailure = 1;   ///< verification failed, or an internal error
 inline constexpr int kExitUsage = 2;     ///< bad command line
 inline constexpr int kExitBadInput = 3;  ///< unreadable, truncated or corrupted input file
+inline constexpr int kExitOutput = 4;    ///< an output cannot be created or written
+inline constexpr int kExitNotConverged = 5;  ///< a render stopped at its pass limit (images written)
 
 /// Bad input from the user (command line values, inconsistent options).
 class InputError : public std::runtime_error {
@@ -54,6 +56,13 @@ class FileError : public InputError {
 
  private:
   std::filesystem::path mPath;
+};
+
+/// An output that cannot be created or written (a missing or read-only directory, a full
+/// disk). Tools exit with kExitOutput.
+class OutputError : public FileError {
+ public:
+  using FileError::FileError;
 };
 
 /// A violated internal invariant.

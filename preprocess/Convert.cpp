@@ -422,7 +422,7 @@ class StoreDirectory {
     if (!std::filesystem::exists(dir, ec)) {
       mCleanup = CleanupOnSignal(dir, CleanupOnSignal::Kind::Directory);
       if (!std::filesystem::create_directories(dir, ec) && ec)
-        throw FileError(dir, "cannot create the store directory: " + ec.message());
+        throw OutputError(dir, "cannot create the store directory: " + ec.message());
       mCreated = true;
     } else if (!std::filesystem::is_directory(dir, ec)) {
       throw FileError(dir, "exists and is not a directory (a brick store is one)");

@@ -1,6 +1,8 @@
 #include "raycast/Camera.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <fstream>
 #include <span>
 #include <sstream>
@@ -50,8 +52,10 @@ Camera frameOnBox(const Box& box, double aspect, glm::dvec3 up, double fovYDegre
   camera.up = up;
   camera.fovYDegrees = fovYDegrees;
   const glm::dvec3 direction = glm::normalize(0.55 * sideAxis + 1.0 * front + 0.45 * up);
-  camera.eye = camera.target + direction;  // for the view axes below; the distance follows
-  const glm::dvec3 right = camera.right(), trueUp = camera.trueUp();
+  // The view axes from the direction itself (as Camera::right()/trueUp() would give them):
+  // target + direction may round onto the target far from the origin.
+  const glm::dvec3 forward = -direction;
+  const glm::dvec3 right = glm::normalize(glm::cross(forward, up)), trueUp = glm::cross(right, forward);
   // The nearest distance at which all eight corners lie inside the frustum, plus a margin.
   const double tanY = std::tan(glm::radians(fovYDegrees) * 0.5), tanX = tanY * aspect;
   double distance = 0;
@@ -65,6 +69,15 @@ Camera frameOnBox(const Box& box, double aspect, glm::dvec3 up, double fovYDegre
   }
   distance = std::max(distance * 1.08, 1e-9);
   camera.eye = camera.target + direction * distance;
+  // Far from the origin, doubles may be too coarse for the distance the box's size asks for.
+  if (!(glm::length(camera.eye - camera.target) > 0.5 * distance)) {
+    const double farthest = std::max({std::abs(camera.target.x), std::abs(camera.target.y), std::abs(camera.target.z)});
+    std::ostringstream message;
+    message << "the data lies too far from the origin for its size to be viewed: at " << farthest
+            << " from the origin, double-precision numbers are " << farthest * std::numeric_limits<double>::epsilon()
+            << " apart, and the data is only " << glm::length(box.max - box.min) << " across; move it nearer the origin";
+    throw InputError(message.str());
+  }
   return camera;
 }
 

@@ -227,7 +227,7 @@ RenderStats FrameRenderer::trace(int frame, const Camera& camera, int direction)
     while (bricks.size() < wanted.size()) {
       mStreamer->waitIdle();
       auto ready = mStreamer->takeReady(wanted.size());
-      if (mStreamer->stats().failed > failedBefore) throw FileError(mSource->name(), mStreamer->lastError());
+      if (mStreamer->stats().failed > failedBefore) mStreamer->rethrowLastError();
       if (ready.empty())
         throw LogicError("the streamer delivered " + std::to_string(bricks.size()) + " of " +
                          std::to_string(wanted.size()) + " requested bricks");

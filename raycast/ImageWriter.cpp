@@ -42,18 +42,19 @@ void checkImage(const RenderImage& image) {
                   "thickness=" << image.thickness.size() << " pixels=" << n);
 }
 
-/// Runs `write` and turns any failure into a FileError naming `path`.
-template <typename Write>
-void reportingErrors(const std::filesystem::path& path, Write&& write) {
+/// Runs `work` and turns any failure into an `Error` (OutputError for writes, FileError for
+/// reads) naming `path`.
+template <typename Error, typename Work>
+void reportingErrors(const std::filesystem::path& path, Work&& work) {
   try {
-    write();
+    work();
   } catch (const FileError& e) {
-    if (e.path() == path) throw;
-    throw FileError(path, e.what());  // names the temporary file too
+    if (e.path() == path && dynamic_cast<const Error*>(&e)) throw;
+    throw Error(path, e.what());  // names the temporary file too
   } catch (const LogicError&) {
     throw;
   } catch (const std::exception& e) {
-    throw FileError(path, e.what());
+    throw Error(path, e.what());
   }
 }
 
@@ -142,7 +143,7 @@ void writeExr(const std::filesystem::path& path, const RenderImage& image) {
     }
   }
 
-  reportingErrors(path, [&] {
+  reportingErrors<OutputError>(path, [&] {
     AtomicFile file(path);
     AtomicFileStream stream(file);
     {
@@ -150,7 +151,7 @@ void writeExr(const std::filesystem::path& path, const RenderImage& image) {
       exr.setFrameBuffer(frame);
       exr.writePixels(int(image.height));
     }  // ~OutputFile writes the line offset table
-    if (stream.failure()) throw FileError(path, "write failed: " + *stream.failure());
+    if (stream.failure()) throw OutputError(path, "write failed: " + *stream.failure());
     file.commit();
   });
 }
@@ -183,9 +184,9 @@ void writePng(const std::filesystem::path& path, const RenderImage& image) {
   const bool ok = png_image_write_to_memory(&png, encoded.data(), &bytes, 0, pixels.data(), 0, nullptr);
   const std::string message = png.message;
   png_image_free(&png);
-  if (!ok) throw FileError(path, "libpng cannot encode the image: " + message);
+  if (!ok) throw OutputError(path, "libpng cannot encode the image: " + message);
   encoded.resize(bytes);
-  reportingErrors(path, [&] { writeFileAtomically(path, encoded); });
+  reportingErrors<OutputError>(path, [&] { writeFileAtomically(path, encoded); });
 }
 
 bool isImagePath(const std::filesystem::path& path) {
@@ -205,7 +206,7 @@ void writeImage(const std::filesystem::path& path, const RenderImage& image) {
 
 ExrContents readExr(const std::filesystem::path& path) {
   ExrContents contents;
-  reportingErrors(path, [&] {
+  reportingErrors<FileError>(path, [&] {
     Imf::InputFile exr(path.c_str());
     const Imf::Header& header = exr.header();
     for (auto it = header.channels().begin(); it != header.channels().end(); ++it)

@@ -138,8 +138,23 @@ StreamerStats Streamer::stats() const {
 }
 
 std::string Streamer::lastError() const {
-  std::lock_guard lock(mMutex);
-  return mLastError;
+  try {
+    rethrowLastError();
+  } catch (const std::exception& e) {
+    return e.what();
+  } catch (...) {
+    return "an exception that is not a std::exception";
+  }
+  return "";
+}
+
+void Streamer::rethrowLastError() const {
+  std::exception_ptr error;
+  {
+    std::lock_guard lock(mMutex);
+    error = mLastError;
+  }
+  if (error) std::rethrow_exception(error);
 }
 
 std::shared_ptr<const BrickCells> Streamer::cellsOf(const BrickKey& key) {
@@ -194,7 +209,7 @@ void Streamer::work() {
     }
     std::shared_ptr<const ConvertedBrick> brick;
     bool fromCache = false, failed = false;
-    std::string error;
+    std::exception_ptr error;
     try {
       brick = mCache.find(job.key);
       fromCache = brick != nullptr;
@@ -202,9 +217,9 @@ void Streamer::work() {
         brick = convert(job.key);
         if (brick) mCache.insert(brick);
       }
-    } catch (const std::exception& e) {
+    } catch (...) {
       failed = true;
-      error = e.what();
+      error = std::current_exception();
     }
     {
       std::lock_guard lock(mMutex);

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <condition_variable>
+#include <exception>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -75,7 +76,11 @@ class Streamer {
   void waitIdle();
 
   StreamerStats stats() const;
+  /// The message of the last brick whose source threw ("" if none).
   std::string lastError() const;
+  /// Rethrows the last brick failure as it was thrown on the worker, type included (a damaged
+  /// file stays a FileError, a bug a LogicError); nothing if no brick failed.
+  void rethrowLastError() const;
   const ConvertedBrickCache& cache() const { return mCache; }
 
  private:
@@ -112,7 +117,7 @@ class Streamer {
   std::size_t mInFlight = 0;
   bool mStopping = false;
   StreamerStats mStats;
-  std::string mLastError;
+  std::exception_ptr mLastError;
   std::vector<std::thread> mWorkers;
 };
 

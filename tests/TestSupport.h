@@ -39,9 +39,14 @@ struct CommandRun {
   std::string output;  ///< stdout and stderr together
 };
 
+/// How long one flipscope run of a test may take before `timeout` stops it (exit 124; KILL 10 s
+/// later): a hung command fails its test instead of hanging the suite.
+inline constexpr int kCommandTimeoutSeconds = 240;
+
 /// Runs `flipscope <arguments>` (a shell fragment) in `directory` (or the current one).
 inline CommandRun runFlipscope(const std::string& arguments, const std::filesystem::path& directory = {}) {
-  std::string command = "'" FLIPSCOPE_BINARY "' " + arguments + " 2>&1";
+  std::string command = "timeout -k 10 " + std::to_string(kCommandTimeoutSeconds) + " '" FLIPSCOPE_BINARY "' " +
+                        arguments + " 2>&1";
   if (!directory.empty()) command = "cd '" + directory.string() + "' && " + command;
   FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) return {-1, "popen failed"};

@@ -7,7 +7,6 @@
 #include <nlohmann/json.hpp>
 
 #include <fcntl.h>
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -17,9 +16,11 @@
 #include <thread>
 
 #include "core/Error.h"
+#include "core/ProcessMemory.h"
 #include "preprocess/Convert.h"
-#include "preprocess/ParticleWriter.h"
+#include "preprocess/particles/ParticleWriter.h"
 #include "preprocess/SynthFluid.h"
+#include "tools/JsonOutput.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
 
@@ -63,11 +64,6 @@ std::uint64_t readRaw(const std::vector<fs::path>& files) {
   return total;
 }
 
-double peakRssBytes() {
-  rusage usage{};
-  ::getrusage(RUSAGE_SELF, &usage);
-  return double(usage.ru_maxrss) * 1024.0;
-}
 
 void runBenchPreprocess(const BenchPreprocessArgs& a) {
   const fs::path work = a.workDir.empty()
@@ -139,11 +135,11 @@ void runBenchPreprocess(const BenchPreprocessArgs& a) {
                      {"bricks", frame.bricks},
                      {"store_bytes", frame.storeBytes},
                      {"store_to_raw", double(frame.storeBytes) / rawFloatBytes},
-                     {"peak_rss_bytes", peakRssBytes()},
+                     {"peak_rss_bytes", double(peakResidentBytes())},
                      {"mem_budget_bytes", options.memoryBudget},
                      {"out_of_core", frame.spillBuckets > 0},
                      {"source", source}};
-    std::printf("%s\n", j.dump(2).c_str());
+    printJson(j);
     return;
   }
   std::printf("bench preprocess: %s\n", source.c_str());
@@ -159,7 +155,7 @@ void runBenchPreprocess(const BenchPreprocessArgs& a) {
   std::printf("store: %u bricks, %s bytes = %.3f of raw float32 (target <= 0.25): %s\n", frame.bricks,
               Progress::humanCount(double(frame.storeBytes)).c_str(), double(frame.storeBytes) / rawFloatBytes,
               double(frame.storeBytes) / rawFloatBytes <= 0.25 ? "met" : "NOT met");
-  std::printf("peak RSS %s bytes with --mem %s\n", Progress::humanCount(peakRssBytes()).c_str(), a.mem.c_str());
+  std::printf("peak RSS %s bytes with --mem %s\n", Progress::humanCount(double(peakResidentBytes())).c_str(), a.mem.c_str());
 }
 
 }  // namespace

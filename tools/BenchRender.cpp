@@ -15,10 +15,11 @@
 
 #include "core/Error.h"
 #include "preprocess/Convert.h"
-#include "preprocess/ParticleWriter.h"
+#include "preprocess/particles/ParticleWriter.h"
 #include "preprocess/SynthFluid.h"
 #include "raycast/GpuRaycaster.h"
 #include "pipeline/FramePipeline.h"
+#include "tools/JsonOutput.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
 
@@ -172,7 +173,7 @@ void runBenchRender(const BenchRenderArgs& a) {
                             {"cold_bricks", r.cold.bricksUploaded},
                             {"frame_ms", r.frameMs},
                             {"trace_ms", r.traceMs}});
-    std::printf("%s\n", j.dump(2).c_str());
+    printJson(j);
     return;
   }
   std::printf("bench render: %s synth particles (1 frame, %zu non-empty bricks), device %s\n\n",

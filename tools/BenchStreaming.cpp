@@ -14,6 +14,7 @@
 #include "streaming/BrickMipmap.h"
 #include "streaming/Streamer.h"
 #include "streaming/SyntheticBrickSource.h"
+#include "tools/JsonOutput.h"
 #include "tools/Commands.h"
 
 namespace flipscope::tools {
@@ -179,7 +180,7 @@ void run(bool json, int reps) {
                               {"budget_bytes", s.budget},
                               {"hit_rate_per_pass", s.hitRatePerPass},
                               {"cache_bytes", s.cacheBytes}});
-    std::printf("%s\n", out.dump(2).c_str());
+    printJson(out);
     return;
   }
   std::printf(

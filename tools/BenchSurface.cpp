@@ -51,12 +51,13 @@
 #include "gl/EglContext.h"
 #include "pipeline/FramePipeline.h"
 #include "preprocess/Convert.h"
-#include "preprocess/PointSpanSource.h"
+#include "preprocess/particles/PointSpanSource.h"
 #include "raycast/RaycastTypes.h"
 #include "smoothing/CpuScreenDevice.h"
 #include "smoothing/GpuScreenDevice.h"
 #include "smoothing/SurfaceNormals.h"
 #include "smoothing/SurfaceShading.h"
+#include "tools/JsonOutput.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
 
@@ -483,7 +484,7 @@ void runBenchSurface(const BenchSurfaceArgs& a) {
                   {"bilateral_ms", kPaperBilateralMs},
                   {"rof_ms", kPaperRofMs},
                   {"rof_iterations", kPaperRofIterations}};
-    std::printf("%s\n", j.dump(2).c_str());
+    printJson(j);
     return;
   }
 

@@ -1,6 +1,8 @@
 #include "tools/CliValues.h"
 
+#include <charconv>
 #include <cmath>
+#include <string_view>
 #include <cstdio>
 #include <sstream>
 #include <vector>
@@ -85,12 +87,19 @@ Box parseBox(const std::string& option, const std::string& text) {
 }
 
 std::pair<std::uint32_t, std::uint32_t> parseImageSize(const std::string& option, const std::string& text) {
-  unsigned width = 0, height = 0;
-  char x = 0, extra = 0;
-  if (std::sscanf(text.c_str(), "%u%c%u%c", &width, &x, &height, &extra) != 3 || (x != 'x' && x != 'X') || width == 0 ||
-      height == 0)
-    bad(option, text, "WxH, e.g. 1920x1080");
-  return {width, height};
+  constexpr std::uint64_t kMaxSide = 32768;  // a 1 Gpixel image at most: beyond, buffers cannot be allocated
+  const std::string expected = "WxH with sides 1 to " + std::to_string(kMaxSide) + ", e.g. 1920x1080";
+  const auto cross = text.find_first_of("xX");
+  if (cross == std::string::npos) bad(option, text, expected);
+  auto side = [&](std::string_view digits) {
+    std::uint64_t value = 0;
+    auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+    if (digits.empty() || ec != std::errc() || end != digits.data() + digits.size() || value == 0 || value > kMaxSide)
+      bad(option, text, expected);
+    return std::uint32_t(value);
+  };
+  const std::string_view all(text);
+  return {side(all.substr(0, cross)), side(all.substr(cross + 1))};
 }
 
 DeviceChoice parseDeviceChoice(const std::string& option, const std::string& text) {

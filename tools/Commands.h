@@ -5,6 +5,7 @@
 #pragma once
 
 #include <stdexcept>
+#include <string>
 
 namespace CLI {
 class App;
@@ -12,10 +13,16 @@ class App;
 
 namespace flipscope::tools {
 
-/// A command finished and printed its findings but must exit with kExitFailure.
+/// A command finished and printed its findings but must exit with `exitCode` (kExitFailure,
+/// or kExitNotConverged for a render that stopped at its pass limit).
 class CommandFailed : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  explicit CommandFailed(const std::string& message, int exitCode = 1)
+      : std::runtime_error(message), mExitCode(exitCode) {}
+  int exitCode() const { return mExitCode; }
+
+ private:
+  int mExitCode;
 };
 
 void addConvertCommand(CLI::App& app);

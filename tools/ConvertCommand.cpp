@@ -6,8 +6,9 @@
 
 #include "core/AtomicFile.h"
 #include "core/Error.h"
+#include "core/ProcessMemory.h"
 #include "preprocess/Convert.h"
-#include "preprocess/InputSequence.h"
+#include "preprocess/particles/InputSequence.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
 
@@ -74,6 +75,7 @@ void runConvert(const ConvertArgs& a) {
                   (unsigned long long)f.stats.skippedOutside);
     std::printf("\n");
   }
+  std::printf("peak memory %.0f MiB (--mem %s)\n", double(peakResidentBytes()) / (1 << 20), a.mem.c_str());
 }
 
 }  // namespace

@@ -10,8 +10,9 @@
 
 #include "core/Error.h"
 #include "core/Progress.h"
-#include "preprocess/BrickStore.h"
-#include "preprocess/StoreInspection.h"
+#include "preprocess/store/BrickStore.h"
+#include "preprocess/store/StoreInspection.h"
+#include "tools/JsonOutput.h"
 #include "tools/Commands.h"
 
 namespace flipscope::tools {
@@ -106,7 +107,7 @@ void runInfo(const InfoArgs& a) {
       j["verified"] = damage.empty();
       j["damage"] = damage;
     }
-    std::printf("%s\n", j.dump(2).c_str());
+    printJson(j);
   } else {
     std::printf("store      %s (version %u, id %s)\n", a.store.c_str(), h.version, storeIdText(h.id).c_str());
     std::printf("domain     origin (%g, %g, %g), cell size %g, %ux%ux%u bricks of %u^3 cells\n", h.origin.x, h.origin.y,

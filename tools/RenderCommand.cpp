@@ -2,11 +2,12 @@
 // previews of the smoothed, shaded liquid surface, headless.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <memory>
 #include <tuple>
 
 #include "core/Error.h"
-#include "preprocess/InputSequence.h"
+#include "preprocess/particles/InputSequence.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
 #include "smoothing/SurfaceFilter.h"
@@ -94,7 +95,14 @@ void runRender(const RenderArgs& a) {
   job.up = parseUp(a.up);
   job.device = parseDeviceChoice("--device", a.device);
   job.quiet = a.quiet;
-  runRenderJob(job);
+  const auto files = runRenderJob(job);
+  const auto unconverged = std::count_if(files.begin(), files.end(), [](const RenderedFile& f) { return !f.stats.converged; });
+  if (unconverged > 0)
+    throw CommandFailed("render: " + std::to_string(unconverged) + " of " + std::to_string(files.size()) +
+                            " frame(s) stopped at --max-passes " + std::to_string(a.maxPasses) +
+                            " before every ray finished; the images are written but incomplete (raise --max-passes, "
+                            "or give --gpu-mem enough for the frame)",
+                        kExitNotConverged);
 }
 
 }  // namespace

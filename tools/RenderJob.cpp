@@ -66,7 +66,11 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
   } else {
     Box bounds = renderer.occupiedBounds(first, last);  // all frames: a flipbook keeps one camera
     if (bounds.isEmpty()) bounds = Box{store.header().origin, store.header().domainMax()};
-    camera = frameOnBox(bounds, double(settings.width) / settings.height, job.up);
+    try {
+      camera = frameOnBox(bounds, double(settings.width) / settings.height, job.up);
+    } catch (const InputError& e) {
+      throw FileError(job.store, e.what());
+    }
   }
 
   std::vector<RenderedFile> files;

@@ -5,10 +5,12 @@
 #include <exception>
 
 #include "core/Error.h"
+#include "core/ProcessMemory.h"
 #include "tools/Commands.h"
 
 int main(int argc, char** argv) {
   using namespace flipscope;
+  limitHeapRetention();  // peak RSS within --mem (core/ProcessMemory.h)
   CLI::App app{"flipscope: preview giga-particle fluid simulation caches (Reichl et al. 2014)", "flipscope"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "flipscope 0.1.0");
@@ -23,6 +25,9 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     int code = app.exit(e);
     return code == 0 ? kExitOk : kExitUsage;
+  } catch (const OutputError& e) {
+    std::fprintf(stderr, "flipscope: error: %s\n", e.what());
+    return kExitOutput;
   } catch (const FileError& e) {
     std::fprintf(stderr, "flipscope: error: %s\n", e.what());
     return kExitBadInput;
@@ -31,7 +36,7 @@ int main(int argc, char** argv) {
     return kExitUsage;
   } catch (const tools::CommandFailed& e) {
     std::fprintf(stderr, "flipscope: %s\n", e.what());
-    return kExitFailure;
+    return e.exitCode();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "flipscope: internal error: %s\n", e.what());
     return kExitFailure;

@@ -1,8 +1,10 @@
 // Frame patterns of `flipscope convert` inputs: `####` (zero padded to the run's width),
-// printf `%d` / `%0Nd`, and `{}`; expansion into frames from a range or the directory listing.
+// printf `%d` / `%0Nd`, `{}`, and Houdini's `$F` / `$F4`; expansion into frames from a range or
+// the directory listing.
 #include "preprocess/particles/InputSequence.h"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <set>
 
@@ -26,6 +28,15 @@ std::optional<FramePattern> findPattern(const std::string& input) {
       return FramePattern{input.substr(0, i), input.substr(end), int(end - i)};
     }
     if (input.compare(i, 2, "{}") == 0) return FramePattern{input.substr(0, i), input.substr(i + 2), 0};
+    // Houdini's $F (unpadded) and $F2 to $F9 (zero padded), as in `name.$F4.bgeo.sc`; not
+    // $FF, $FPS, $FSTART and other variables that begin with F.
+    if (input.compare(i, 2, "$F") == 0) {
+      std::size_t j = i + 2;
+      int width = 0;
+      if (j < input.size() && input[j] >= '1' && input[j] <= '9') width = input[j++] - '0';
+      if (j == input.size() || !std::isalnum(static_cast<unsigned char>(input[j])))
+        return FramePattern{input.substr(0, i), input.substr(j), width};
+    }
     if (input[i] == '%') {
       std::size_t j = i + 1;
       int width = 0;
@@ -75,7 +86,12 @@ std::vector<int> discoverFrames(const std::string& input, const FramePattern& pa
 
 void expectFile(const std::filesystem::path& path, const std::string& context) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw FileError(path, "no such file (" + context + ")");
+  const auto status = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(status)) throw FileError(path, "no such file (" + context + ")");
+  if (std::filesystem::is_directory(status))
+    throw FileError(path, "is a directory, expected a particle file (" + context + ")");
+  if (!std::filesystem::is_regular_file(status))
+    throw FileError(path, "is not a regular file (a device, pipe or socket), expected a particle file (" + context + ")");
 }
 
 }  // namespace

@@ -446,7 +446,9 @@ BrickStore BrickStore::createOrAppend(const std::filesystem::path& dir, const St
   StoreHeader fresh = header;
   fresh.version = kStoreVersion;
   if (fresh.id == StoreId{}) fresh.id = randomStoreId();
-  std::filesystem::create_directories(dir);
+  std::error_code created;
+  std::filesystem::create_directories(dir, created);
+  if (created) throw OutputError(dir, "cannot create the store directory: " + created.message());
   writeFileAtomically(dir / kStoreHeaderName, serializeStoreHeader(fresh));
   return open(dir);
 }

@@ -58,6 +58,14 @@ TEST(FuzzRegressions, EveryCrasherIsHandled) {
       ++inputs;
     }
   std::printf("%zu crasher inputs replayed\n", inputs);
+  // Every regressions/ folder is replayed (a renamed target would leave its crashers unread).
+  std::size_t folders = 0, inFolders = 0;
+  for (const auto& folder : std::filesystem::directory_iterator(kFuzzDir / "regressions")) {
+    ++folders;
+    inFolders += filesIn(folder.path()).size();
+  }
+  EXPECT_GT(folders, 0u);
+  EXPECT_EQ(inputs, inFolders) << "a regressions/ folder is named after no fuzz target";
 }
 
 }  // namespace

@@ -2,6 +2,8 @@
 // here) against the CPU reference, image for image.
 #include <gtest/gtest.h>
 
+#include "GlTestSupport.h"
+
 #include <cmath>
 
 #include "TestSupport.h"
@@ -22,7 +24,7 @@ TEST(FramePipelineGl, EqualsTheCpuReference) {
   try {
     gpu.emplace(store, DeviceChoice::Gpu, settings, SurfaceSettings{});
   } catch (const gl::Unavailable& e) {
-    GTEST_SKIP() << "no EGL/OpenGL 4.5 device: " << e.what();
+    FLIPSCOPE_SKIP_WITHOUT_GL(e.what());
   }
   FramePipeline cpu(store, DeviceChoice::Cpu, settings, SurfaceSettings{});
   Camera camera = ball.camera();

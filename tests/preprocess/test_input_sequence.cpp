@@ -18,6 +18,10 @@ TEST(InputSequence, SubstitutesEveryPatternKind) {
   EXPECT_EQ(substituteFrame("f_%d.ply", 12), "f_12.ply");
   EXPECT_EQ(substituteFrame("f_{}.bin", 3), "f_3.bin");
   EXPECT_EQ(substituteFrame("plain.vdb", 3), "plain.vdb");
+  EXPECT_EQ(substituteFrame("splash.$F4.bgeo.sc", 12), "splash.0012.bgeo.sc");
+  EXPECT_EQ(substituteFrame("splash.$F.bgeo.sc", 12), "splash.12.bgeo.sc");
+  EXPECT_EQ(substituteFrame("a/$FPS/b.$F2.geo", 3), "a/$FPS/b.03.geo");  // $FPS is another variable
+  EXPECT_FALSE(hasFramePattern("x.$FSTART.bgeo"));
   EXPECT_TRUE(hasFramePattern("x_#.vdb"));
   EXPECT_TRUE(hasFramePattern("x_%03d.vdb"));
   EXPECT_TRUE(hasFramePattern("x_{}.vdb"));
@@ -57,6 +61,13 @@ TEST(InputSequence, DiscoversFramesInTheDirectory) {
     }
     EXPECT_EQ(numbers, (std::vector<int>{3, 7, 12, 100}));
   }
+  touch(dir / "splash.0001.bgeo.sc");
+  touch(dir / "splash.0002.bgeo.sc");
+  touch(dir / "splash.0002.bgeo");  // another extension: not a frame of the .bgeo.sc pattern
+  auto houdini = expandInputs({(dir / "splash.$F4.bgeo.sc").string()}, std::nullopt);
+  ASSERT_EQ(houdini.size(), 2u);
+  EXPECT_EQ(houdini[1].frame, 2);
+  EXPECT_EQ(houdini[1].files[0], dir / "splash.0002.bgeo.sc");
   auto unpadded = expandInputs({(dir / "fluid_{}.vdb").string()}, std::nullopt);
   ASSERT_EQ(unpadded.size(), 1u);
   EXPECT_EQ(unpadded[0].frame, 12);

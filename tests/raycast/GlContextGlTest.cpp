@@ -3,6 +3,8 @@
 // buffers and timer queries work. Skips only when EglContext::create throws gl::Unavailable.
 #include <gtest/gtest.h>
 
+#include "GlTestSupport.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -28,7 +30,7 @@ class GlContext : public ::testing::Test {
     try {
       context = gl::EglContext::create();
     } catch (const gl::Unavailable& e) {
-      GTEST_SKIP() << "no OpenGL 4.5 context: " << e.what();
+      FLIPSCOPE_SKIP_WITHOUT_GL(e.what());
     }
   }
   gl::EglContext context;
@@ -87,7 +89,9 @@ TEST_F(GlContext, TwoContextsShareTheDisplaySafely) {
   EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR));
 }
 
-TEST_F(GlContext, SharedMathMatchesCpuBitForBit) {
+// Morton codes bit for bit; jitter within one float rounding of the C++ (the count of bit-exact
+// components is printed).
+TEST_F(GlContext, SharedMathMatchesCpu) {
   const gl::Program program = gl::Program::compute(gl::shaderSource("SharedMathTest.comp"), "SharedMathTest.comp");
   constexpr std::uint32_t kCount = 1000;
   constexpr float kMaxJitter = 0.35f;
@@ -187,7 +191,8 @@ TEST_F(GlContext, TimerQueryMeasuresADispatch) {
     std::uint32_t pad[2];
   } params{4096, 0.5f, {0, 0}};
   gl::Buffer paramBuffer(sizeof params, &params);
-  gl::Buffer inputs(4096 * 16), mortons(4096 * 4), jitters(4096 * 16);
+  const std::vector<std::uint32_t> unset(4096, 0xffffffffu);  // what the dispatch must overwrite
+  gl::Buffer inputs(4096 * 16), mortons(4096 * 4, unset.data()), jitters(4096 * 16);
   inputs.clearZero();
   paramBuffer.bindBase(GL_UNIFORM_BUFFER, 0);
   inputs.bindBase(GL_SHADER_STORAGE_BUFFER, 0);
@@ -200,9 +205,13 @@ TEST_F(GlContext, TimerQueryMeasuresADispatch) {
   program.dispatch(4096 / 64);
   timer.end();
   const double ms = timer.milliseconds();
-  EXPECT_GE(ms, 0.0);
-  EXPECT_LT(ms, 60'000.0);
+  EXPECT_GT(ms, 0.0) << "the timer saw no work";
   std::cout << "[          ] dispatch of 4096 invocations: " << ms << " ms\n";
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  std::vector<std::uint32_t> codes(4096);
+  mortons.download(0, codes.size() * 4, codes.data());
+  for (std::size_t i = 0; i < codes.size(); ++i)
+    ASSERT_EQ(codes[i], flipscope::mortonEncode3(0, 0, 0)) << "invocation " << i << " did not run";
   EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR));
 }
 

@@ -3,6 +3,8 @@
 // pool converging by eviction. Skips only when no EGL/OpenGL 4.5 context can be made.
 #include <gtest/gtest.h>
 
+#include "GlTestSupport.h"
+
 #include <cstring>
 
 #include "RaycastScenes.h"
@@ -29,7 +31,7 @@ std::unique_ptr<FrameRenderer> gpuRenderer(const BrickStore& store, const Render
 #define GPU_RENDERER(var, store, settings)             \
   std::string skip_##var;                              \
   auto var = gpuRenderer(store, settings, skip_##var); \
-  if (!var) GTEST_SKIP() << "no EGL/OpenGL 4.5 device: " << skip_##var
+  if (!var) FLIPSCOPE_SKIP_WITHOUT_GL(skip_##var)
 
 /// Compares GPU and CPU rays: the same hit/miss decision on all but `maxMismatch` pixels, and
 /// on pixels both hit, distances within 1e-4 relative and attributes equal.

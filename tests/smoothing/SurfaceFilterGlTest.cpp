@@ -2,6 +2,8 @@
 // on a roughened sphere in front of a plane at 128x72.
 #include <gtest/gtest.h>
 
+#include "GlTestSupport.h"
+
 #include <memory>
 
 #include "gl/EglContext.h"
@@ -17,7 +19,7 @@ class SurfaceFilterGl : public ::testing::TestWithParam<std::string> {
     try {
       mContext = gl::EglContext::create();
     } catch (const gl::Unavailable& e) {
-      GTEST_SKIP() << "no EGL/OpenGL 4.5 device: " << e.what();
+      FLIPSCOPE_SKIP_WITHOUT_GL(e.what());
     }
   }
   gl::EglContext mContext;

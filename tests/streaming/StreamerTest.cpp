@@ -4,8 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <stdexcept>
+#include <type_traits>
 #include <thread>
 
+#include "core/Error.h"
 #include "streaming/BrickMipmap.h"
 #include "streaming/Streamer.h"
 #include "streaming/SyntheticBrickSource.h"
@@ -61,6 +64,35 @@ TEST(Streamer, DeliversEveryNonEmptyBrickLikeDirectConversion) {
     EXPECT_EQ(brick->mipmap, expected.mipmap);
   }
   EXPECT_EQ(streamer.stats().failed, 0u) << streamer.lastError();
+}
+
+// A source whose reads throw `Error`: what a damaged frame file (FileError) or a bug
+// (LogicError) looks like from a worker thread.
+template <class Error>
+class ThrowingSource final : public SyntheticBrickSource {
+ public:
+  using SyntheticBrickSource::SyntheticBrickSource;
+  std::shared_ptr<const DecodedBrick> read(const BrickKey&) override {
+    if constexpr (std::is_same_v<Error, FileError>) throw FileError("frame_0000.fsf", "brick read failed");
+    else throw Error("brick read failed");
+  }
+};
+
+template <class Error>
+void expectFailureKeepsItsType() {
+  auto source = std::make_shared<ThrowingSource<Error>>(kBrick, kGrid, 4, 0.3);
+  Streamer streamer(source, smallOptions());
+  EXPECT_NO_THROW(streamer.rethrowLastError());  // nothing failed yet
+  streamer.request(source->bricks(0));
+  takeAll(streamer);
+  EXPECT_GT(streamer.stats().failed, 0u);
+  EXPECT_NE(streamer.lastError().find("brick read failed"), std::string::npos);
+  EXPECT_THROW(streamer.rethrowLastError(), Error);
+}
+
+TEST(Streamer, WorkerFailuresKeepTheirType) {
+  expectFailureKeepsItsType<FileError>();  // exit 3 in the tools
+  expectFailureKeepsItsType<LogicError>();  // exit 1: a bug stays a bug
 }
 
 TEST(Streamer, MergesDuplicateRequests) {
@@ -143,11 +175,14 @@ TEST(Streamer, ReadAheadFillsTheCacheInThePlayingDirection) {
   std::vector<glm::uvec3> coords = source->bricks(3);
   streamer.request(coords);
   takeAll(streamer);
+  std::size_t checked = 0;
   for (glm::uvec3 c : coords) {
     if (!source->read({2, c})) continue;
     EXPECT_TRUE(streamer.cache().contains({2, c}));
     EXPECT_FALSE(streamer.cache().contains({4, c}));
+    ++checked;
   }
+  EXPECT_GT(checked, 0u) << "frame 2 shares no brick with frame 3: nothing was checked";
   streamer.setFrame(2, -1);
   streamer.request(coords);
   takeAll(streamer);
@@ -198,10 +233,13 @@ TEST(Streamer, ConcurrentScrubbingWithEvictionStaysCorrectAndWithinBudget) {
   EXPECT_EQ(streamer.stats().failed, 0u) << streamer.lastError();
   // After the dust settles, the final frame's bricks come back right.
   streamer.request(last);
+  std::size_t checked = 0;
   for (const auto& brick : takeAll(streamer)) {
     EXPECT_EQ(brick->key.frame, 2);
     EXPECT_EQ(brick->bits, expectedBrick(*source, brick->key, options).bits);
+    ++checked;
   }
+  EXPECT_GT(checked, 0u) << "nothing was delivered for the final frame";
 }
 
 TEST(ConvertedBrickCache, NeverAboveBudgetAndEvictsLeastRecentlyUsed) {

@@ -45,6 +45,11 @@ TEST_F(Cli, SynthConvertInfoRoundTrip) {
   ASSERT_EQ(run("synth -o " + path("extra.ply") + " --particles 20k --frames 3 --velocity").exitCode, 0);
   CommandRun append = run("convert " + path("extra.ply") + " -o " + path("store"));
   EXPECT_EQ(append.exitCode, 0) << append.output;
+  CommandRun after = run("info --json " + path("store"));
+  ASSERT_EQ(after.exitCode, 0) << after.output;
+  const auto k = nlohmann::json::parse(after.output);
+  EXPECT_EQ(k["frames"].size(), 3u);
+  for (const char* key : {"cell_size", "origin", "brick_grid", "store_id", "brick_size"}) EXPECT_EQ(k[key], j[key]) << key;
 }
 
 TEST_F(Cli, DefaultConvertOfMantaflowMakesOneCellPerParticleSpacingAndInfoShowsIt) {
@@ -112,7 +117,7 @@ TEST_F(Cli, BadInputsGiveClearErrorsAndExitCodes) {
   EXPECT_FALSE(fs::exists(dir / "s1" / "frame_000000.fsf"));
 
   CommandRun missing = run("convert " + path("nothing.ply") + " -o " + path("s2"));
-  EXPECT_NE(missing.exitCode, 0);
+  EXPECT_EQ(missing.exitCode, 3) << missing.output;
   EXPECT_NE(missing.output.find("nothing.ply"), std::string::npos) << missing.output;
 
   CommandRun badMem = run("convert " + path("odd.bin") + " -o " + path("s3") + " --mem lots");
@@ -147,6 +152,54 @@ TEST_F(Cli, OutOfCoreConvertMatchesInCore) {
     s->replace(s->size() - 16, 8, 8, '\0');
   }
   EXPECT_EQ(a, b);
+}
+
+// Issue 12, list item 8: every kind of failure has its exit code and a message naming the file.
+TEST_F(Cli, ExitCodesAndMessagesForEveryKindOfFailure) {
+  ASSERT_EQ(run("synth -o " + path("f.ply") + " --particles 20k").exitCode, 0);
+  ASSERT_EQ(run("convert " + path("f.ply") + " -o " + path("store") + " -q").exitCode, 0);
+  auto expectRun = [&](const std::string& args, int code, const std::string& says) {
+    const CommandRun r = run(args);
+    EXPECT_EQ(r.exitCode, code) << args << "\n" << r.output;
+    EXPECT_NE(r.output.find(says), std::string::npos) << args << "\n" << r.output;
+  };
+  // Inputs that are not particle files.
+  fs::create_directories(dir / "folder.ply");
+  expectRun("convert " + path("folder.ply") + " -o " + path("s1"), 3, "folder.ply: is a directory");
+  expectRun("convert /dev/null -o " + path("s2"), 3, "/dev/null: is not a regular file");
+  expectRun("convert " + path("none.vdb") + " -o " + path("s3"), 3, "none.vdb: no such file");
+  // Outputs that cannot be created: exit 4, naming them.
+  expectRun("convert " + path("f.ply") + " -o /proc/flipscope-no/store", 4, "/proc/flipscope-no/store");
+  expectRun("render " + path("store") + " -o " + path("no/such/dir/x.png") + " --size 32x18 --device cpu", 4,
+            "no/such/dir/x.png");
+  // Sizes beyond 32 bits are refused, not wrapped.
+  expectRun("render " + path("store") + " -o " + path("x.png") + " --size 4294967360x4294967332", 2, "--size");
+  // A render stopped by its pass limit writes its image and says so with exit 5.
+  expectRun("render " + path("store") + " -o " + path("limit.png") + " --size 64x36 --device cpu --max-passes 1", 5,
+            "--max-passes");
+  EXPECT_TRUE(fs::exists(dir / "limit.png"));
+  // Data far from the origin renders when doubles can frame it, and otherwise says why plainly.
+  auto writeRaw = [&](const std::string& name, float step) {
+    std::ofstream out(path(name), std::ios::binary);
+    for (int i = 0; i < 1000; ++i) {
+      const float p[3] = {1e30f, 1e30f + float(i % 10) * step, 1e30f};
+      out.write(reinterpret_cast<const char*>(p), sizeof p);
+    }
+  };
+  writeRaw("far.bin", 1e23f);
+  writeRaw("tiny.bin", 0);
+  for (const char* name : {"far", "tiny"})
+    ASSERT_EQ(run("convert " + path(std::string(name) + ".bin") + " -o " + path(name) + " -q").exitCode, 0) << name;
+  const CommandRun far = run("render " + path("far") + " -o " + path("far.png") + " --size 32x18 --device cpu");
+  EXPECT_EQ(far.exitCode, 0) << far.output;
+  expectRun("render " + path("tiny") + " -o " + path("tiny.png") + " --size 32x18 --device cpu", 3,
+            "too far from the origin for its size");
+  // info --json on a store whose path is not UTF-8: valid JSON, exit 0.
+  const fs::path odd = dir / "store-\xff\xfe";
+  fs::copy(dir / "store", odd, fs::copy_options::recursive);
+  const CommandRun info = run("info --json '" + odd.string() + "'");
+  EXPECT_EQ(info.exitCode, 0) << info.output;
+  EXPECT_TRUE(nlohmann::json::accept(info.output)) << info.output;
 }
 
 }  // namespace
