@@ -8,6 +8,10 @@
 #include <cstring>
 #include <type_traits>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "preprocess/particles/ParticleSource.h"
 
 namespace flipscope::detail {
@@ -118,6 +122,26 @@ inline void decodeValues(ValueType type, bool bigEndian, const std::byte* src, s
     value_decode::decodeAll<false>(type, src, count, dst);
   else
     value_decode::decodeAll<true>(type, src, count, dst);
+}
+
+/// Float32 values read as stored (big-endian when `bigEndian`) made native, in place.
+inline void swapFloatsToNative(float* values, std::size_t count, bool bigEndian) {
+  if (bigEndian == (std::endian::native == std::endian::big)) return;
+  std::size_t i = 0;
+#if defined(__SSE2__)
+  for (; i + 4 <= count; i += 4) {  // SSE2 has no byte shuffle: swap the bytes of each half, then the halves
+    __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(values + i));
+    v = _mm_or_si128(_mm_slli_epi16(v, 8), _mm_srli_epi16(v, 8));
+    v = _mm_shufflehi_epi16(_mm_shufflelo_epi16(v, 0xb1), 0xb1);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(values + i), v);
+  }
+#endif
+  for (; i < count; ++i) {
+    std::uint32_t bits;
+    std::memcpy(&bits, values + i, 4);
+    bits = __builtin_bswap32(bits);
+    std::memcpy(values + i, &bits, 4);
+  }
 }
 
 /// An unsigned integer of `bytes` (4 or 8) bytes at `src`, in the given byte order.

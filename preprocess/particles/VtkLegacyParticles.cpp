@@ -33,6 +33,7 @@ namespace {
 constexpr std::size_t kMaxWordBytes = 1024;
 constexpr std::size_t kMaxLineBytes = 1 << 16;
 constexpr std::size_t kAsciiCursorBytes = 256 << 10;
+constexpr std::uint64_t kDecodeBytes = 256 << 10;  ///< BINARY values are read and decoded in pieces of this
 constexpr std::uint64_t kMaxArity = 1 << 20;
 constexpr std::string_view kMagic = "# vtk DataFile Version";
 
@@ -427,25 +428,35 @@ class VtkLegacyReader final : public ParticleSource {
 
   bool read(ParticleChunk& chunk, std::size_t maxParticles) override {
     FLIPSCOPE_CHECK(maxParticles > 0);
-    chunk.clear();
     const std::uint64_t n = std::min<std::uint64_t>(maxParticles, mLayout.points - mNext);
     if (n == 0) {
+      chunk.clear();
       chunk.attributes.clear();
       return false;
     }
-    for (auto& s : mStreams) readStream(s, n);
+    // Resized, not cleared: a chunk of the same size is not initialised again.
+    // Each array is read once, straight into the chunk; a second use of it copies the first.
+    mRead.assign(mStreams.size(), nullptr);
+    auto fill = [&](std::size_t stream, float* out) {
+      const std::size_t count = std::size_t(n) * std::size_t(mStreams[stream].array->desc.arity);
+      if (mRead[stream])
+        std::memcpy(out, mRead[stream], count * sizeof(float));
+      else
+        readStream(mStreams[stream], n, out);
+      mRead[stream] = out;
+    };
     static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
     chunk.positions.resize(n);
-    std::memcpy(chunk.positions.data(), mStreams[0].values.data(), n * sizeof(glm::vec3));
-    if (mVelocity) {
-      chunk.velocities.resize(n);
-      std::memcpy(chunk.velocities.data(), mStreams[mVelocityStream].values.data(), n * sizeof(glm::vec3));
-    }
+    fill(0, &chunk.positions[0].x);
+    chunk.velocities.resize(mVelocity ? n : 0);
+    if (mVelocity) fill(mVelocityStream, &chunk.velocities[0].x);
     chunk.attributes.resize(mSelected.size());
     for (std::size_t i = 0; i < mSelected.size(); ++i) {
-      chunk.attributes[i].name = mAttributes[mSelected[i]].name;
-      chunk.attributes[i].arity = mAttributes[mSelected[i]].arity;
-      chunk.attributes[i].values = mStreams[mColumnStreams[i]].values;
+      AttributeColumn& column = chunk.attributes[i];
+      column.name = mAttributes[mSelected[i]].name;
+      column.arity = mAttributes[mSelected[i]].arity;
+      column.values.resize(std::size_t(n) * std::size_t(column.arity));
+      fill(mColumnStreams[i], column.values.data());
     }
     mNext += n;
     return true;
@@ -461,7 +472,6 @@ class VtkLegacyReader final : public ParticleSource {
   struct Stream {
     const LegacyArray* array = nullptr;
     std::unique_ptr<FileCursor> cursor;  ///< ASCII only
-    std::vector<float> values;           ///< of the current chunk
     std::vector<std::byte> bytes;        ///< BINARY scratch
   };
 
@@ -480,32 +490,51 @@ class VtkLegacyReader final : public ParticleSource {
     return mStreams.size() - 1;
   }
 
-  void readStream(Stream& s, std::uint64_t n) {
+  /// The next `n` tuples of `s` into `out`.
+  void readStream(Stream& s, std::uint64_t n, float* out) {
     const LegacyArray& array = *s.array;
     const std::uint64_t arity = std::uint64_t(array.desc.arity);
     const std::uint64_t count = n * arity, first = mNext * arity;
-    s.values.resize(count);
     const std::string what = &array == &mLayout.positions ? "POINTS" : "array '" + array.desc.name + "'";
     if (s.cursor) {
-      s.cursor->parseNumbers(s.values.data(), count, array.desc.type, false,
+      s.cursor->parseNumbers(out, count, array.desc.type, false,
                              what + " at byte " + std::to_string(array.keywordOffset));
       return;
     }
     const LegacyType& type = array.type;
-    const std::uint64_t begin = type.bit ? first / 8 : first * type.bytes;
-    const std::uint64_t end = type.bit ? (first + count + 7) / 8 : (first + count) * type.bytes;
-    s.bytes.resize(end - begin);
-    if (mFile.readAt(array.offset + begin, s.bytes.data(), s.bytes.size()) != s.bytes.size())
-      throw FileError(mFile.path(), "truncated: the file ends inside " + what + " (byte " +
-                                        std::to_string(array.offset + end) + "; it shrank since it was opened?)");
-    if (type.bit) {
-      for (std::uint64_t i = 0; i < count; ++i) {
-        const std::uint64_t bit = first + i - begin * 8;
-        s.values[i] = float((std::uint8_t(s.bytes[bit / 8]) >> (7 - bit % 8)) & 1);
+    if (!type.bit) {
+      // In pieces that stay in the cache between reading and decoding; float32 in place.
+      const std::uint64_t perPiece = kDecodeBytes / type.bytes;
+      for (std::uint64_t done = 0; done < count;) {
+        const std::uint64_t values = std::min(perPiece, count - done);
+        const std::uint64_t at = array.offset + (first + done) * type.bytes, bytes = values * type.bytes;
+        void* target = out + done;
+        if (type.type != ValueType::Float32) {
+          s.bytes.resize(bytes);
+          target = s.bytes.data();
+        }
+        if (mFile.readAt(at, target, bytes) != bytes) truncated(what, at + bytes);
+        if (type.type == ValueType::Float32)
+          swapFloatsToNative(out + done, values, true);
+        else
+          decodeValues(type.type, true, s.bytes.data(), values, out + done);
+        done += values;
       }
       return;
     }
-    decodeValues(type.type, true, s.bytes.data(), count, s.values.data());
+    const std::uint64_t begin = first / 8, end = (first + count + 7) / 8;
+    s.bytes.resize(end - begin);
+    if (mFile.readAt(array.offset + begin, s.bytes.data(), s.bytes.size()) != s.bytes.size())
+      truncated(what, array.offset + end);
+    for (std::uint64_t i = 0; i < count; ++i) {  // bits, the first in the high bit of each byte
+      const std::uint64_t bit = first + i - begin * 8;
+      out[i] = float((std::uint8_t(s.bytes[bit / 8]) >> (7 - bit % 8)) & 1);
+    }
+  }
+
+  [[noreturn]] void truncated(const std::string& what, std::uint64_t end) const {
+    throw FileError(mFile.path(), "truncated: the file ends inside " + what + " (byte " + std::to_string(end) +
+                                      "; it shrank since it was opened?)");
   }
 
   InputFile mFile;
@@ -516,6 +545,7 @@ class VtkLegacyReader final : public ParticleSource {
   std::vector<Stream> mStreams;  ///< [0]: the positions
   std::size_t mVelocityStream = 0;
   std::vector<std::size_t> mColumnStreams;
+  std::vector<const float*> mRead;  ///< per stream: where this chunk's values went
   std::uint64_t mNext = 0;
 };
 

@@ -35,6 +35,7 @@ constexpr std::size_t kXmlCursorBytes = 256 << 10;
 constexpr std::size_t kMaxTagBytes = 64 << 10;
 constexpr std::size_t kStreamCursorBytes = 64 << 10;
 constexpr std::size_t kAsciiCursorBytes = 256 << 10;
+constexpr std::size_t kDecodeBytes = 256 << 10;  ///< binary values are decoded in pieces of this
 constexpr std::uint64_t kMaxBlockBytes = 64 << 20;
 constexpr std::uint64_t kMaxArity = 1 << 20;
 /// zlib's largest expansion: 1032:1, plus a little for the stream header of tiny blocks.
@@ -526,25 +527,40 @@ class ArrayStream {
       mCursor->parseNumbers(out, count, mArray.type, true, mWhat);
       return;
     }
-    const std::size_t bytes = count * valueTypeBytes(mArray.type);
-    mScratch.resize(bytes);
-    if (!mLayout.zlib) {
-      readBytes(mScratch.data(), bytes, "the values");
-    } else {
-      for (std::size_t done = 0; done < bytes;) {
-        if (mBlockAt == mBlock.size()) nextBlock();
-        const std::size_t n = std::min(bytes - done, mBlock.size() - mBlockAt);
-        std::memcpy(mScratch.data() + done, mBlock.data() + mBlockAt, n);
-        mBlockAt += n;
-        done += n;
+    // In pieces that stay in the cache between reading and decoding; float32 in place.
+    const std::size_t size = valueTypeBytes(mArray.type), perPiece = kDecodeBytes / size;
+    for (std::size_t done = 0; done < count;) {
+      const std::size_t values = std::min(perPiece, count - done);
+      if (mArray.type == ValueType::Float32) {
+        payload(reinterpret_cast<std::byte*>(out + done), values * size);
+        swapFloatsToNative(out + done, values, mLayout.bigEndian);
+      } else {
+        mScratch.resize(values * size);
+        payload(mScratch.data(), values * size);
+        decodeValues(mArray.type, mLayout.bigEndian, mScratch.data(), values, out + done);
       }
+      done += values;
     }
-    decodeValues(mArray.type, mLayout.bigEndian, mScratch.data(), count, out);
   }
 
  private:
   [[noreturn]] void fail(const std::string& message) const {
     throw FileError(mPath, "VTK XML: " + mWhat + " " + message);
+  }
+
+  /// The next `bytes` bytes of the values (decompressed).
+  void payload(std::byte* out, std::size_t bytes) {
+    if (!mLayout.zlib) {
+      readBytes(out, bytes, "the values");
+      return;
+    }
+    for (std::size_t done = 0; done < bytes;) {
+      if (mBlockAt == mBlock.size()) nextBlock();
+      const std::size_t n = std::min(bytes - done, mBlock.size() - mBlockAt);
+      std::memcpy(out + done, mBlock.data() + mBlockAt, n);
+      mBlockAt += n;
+      done += n;
+    }
   }
 
   void readBytes(std::byte* out, std::size_t bytes, const char* part) {
@@ -712,35 +728,42 @@ class VtkXmlReader final : public ParticleSource {
 
   bool read(ParticleChunk& chunk, std::size_t maxParticles) override {
     FLIPSCOPE_CHECK(maxParticles > 0);
-    chunk.clear();
     while (mPiece < mLayout.pieces.size() && mInPiece == mLayout.pieces[mPiece].points) {
       ++mPiece;
       mInPiece = 0;
       mStreams.clear();
     }
     if (mPiece == mLayout.pieces.size()) {
+      chunk.clear();
       chunk.attributes.clear();
       return false;
     }
     if (mStreams.empty()) openStreams();
     const XmlPiece& piece = mLayout.pieces[mPiece];
     const std::uint64_t n = std::min<std::uint64_t>(maxParticles, piece.points - mInPiece);
-    for (auto& s : mStreams) {
-      s.values.resize(n * std::uint64_t(s.arity));
-      s.stream->read(s.values.data(), s.values.size());
-    }
-    chunk.positions.resize(n);
+    // Each array is read once, straight into the chunk; a second use of it copies the first.
+    mRead.assign(mStreams.size(), nullptr);
+    auto fill = [&](std::size_t stream, float* out) {
+      const std::size_t count = std::size_t(n) * std::size_t(mStreams[stream].arity);
+      if (mRead[stream])
+        std::memcpy(out, mRead[stream], count * sizeof(float));
+      else
+        mStreams[stream].stream->read(out, count);
+      mRead[stream] = out;
+    };
     static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
-    std::memcpy(chunk.positions.data(), mStreams[0].values.data(), n * sizeof(glm::vec3));
-    if (mVelocity) {
-      chunk.velocities.resize(n);
-      std::memcpy(chunk.velocities.data(), mStreams[mVelocityStream].values.data(), n * sizeof(glm::vec3));
-    }
+    chunk.positions.resize(n);
+    fill(0, &chunk.positions[0].x);
+    // Resized, not cleared: a chunk of the same size is not initialised again.
+    chunk.velocities.resize(mVelocity ? n : 0);
+    if (mVelocity) fill(mVelocityStream, &chunk.velocities[0].x);
     chunk.attributes.resize(mSelected.size());
     for (std::size_t i = 0; i < mSelected.size(); ++i) {
-      chunk.attributes[i].name = mAttributes[mSelected[i]].name;
-      chunk.attributes[i].arity = mAttributes[mSelected[i]].arity;
-      chunk.attributes[i].values = mStreams[mColumnStreams[i]].values;
+      AttributeColumn& column = chunk.attributes[i];
+      column.name = mAttributes[mSelected[i]].name;
+      column.arity = mAttributes[mSelected[i]].arity;
+      column.values.resize(std::size_t(n) * std::size_t(column.arity));
+      fill(mColumnStreams[i], column.values.data());
     }
     mInPiece += n;
     return true;
@@ -757,15 +780,13 @@ class VtkXmlReader final : public ParticleSource {
     const XmlArray* array;
     int arity;
     std::unique_ptr<ArrayStream> stream;
-    std::vector<float> values;
   };
 
   std::size_t addStream(const XmlArray& array, const std::string& what) {
     for (std::size_t i = 0; i < mStreams.size(); ++i)
       if (mStreams[i].array == &array) return i;
     const XmlPiece& piece = mLayout.pieces[mPiece];
-    mStreams.push_back(
-        {&array, array.arity, std::make_unique<ArrayStream>(mFile, mLayout, array, piece.points, what), {}});
+    mStreams.push_back({&array, array.arity, std::make_unique<ArrayStream>(mFile, mLayout, array, piece.points, what)});
     return mStreams.size() - 1;
   }
 
@@ -795,6 +816,7 @@ class VtkXmlReader final : public ParticleSource {
   std::vector<Stream> mStreams;  ///< of the current piece; [0]: the points
   std::size_t mVelocityStream = 0;
   std::vector<std::size_t> mColumnStreams;
+  std::vector<const float*> mRead;  ///< per stream: where this chunk's values went
 };
 
 }  // namespace
