@@ -158,7 +158,7 @@ std::string_view FileCursor::wordOnLine(std::size_t maxLength, std::string_view 
 
 std::string_view FileCursor::line(std::size_t maxLength, std::string_view what) {
   auto w = window(std::min(mCapacity, maxLength + 2));
-  const auto* newline = static_cast<const char*>(std::memchr(w.data(), '\n', w.size()));
+  const auto* newline = w.empty() ? nullptr : static_cast<const char*>(std::memchr(w.data(), '\n', w.size()));
   if (!newline) {
     if (w.size() > maxLength)
       fail(std::string(what) + " at byte " + std::to_string(offset()) + " is longer than " + std::to_string(maxLength) +
