@@ -7,8 +7,9 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
-#include <ctime>
 #include <cstdio>
+#include <cstring>
+#include <ctime>
 #include <filesystem>
 
 #include "ParticleTestSupport.h"
@@ -265,6 +266,25 @@ TEST(VtkLegacyReader, NamesAreDecodedAndKeywordsAnyCase) {
   ASSERT_EQ(all.particles.size(), 2u);
   EXPECT_EQ(all.particles.positions[1], glm::vec3(3, 4, 5));
   EXPECT_EQ(all.columns[0], (std::vector<float>{1.5f, 2.5f}));
+}
+
+TEST(VtkLegacyReader, CarriageReturnLineBreaks) {
+  const auto xyz = testing::vtkTestPositions(40, 36);
+  const auto id = testing::vtkTestArray("id", ValueType::UInt32, 1, 40, 37, Kind::Scalars);
+  for (bool binary : {false, true}) {
+    LegacyVtkOptions options;
+    options.binary = binary;
+    std::string text = testing::legacyVtk(xyz, {id}, options);
+    if (!binary) {  // every line break
+      std::string crlf;
+      for (char c : text) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+      text = crlf;
+    } else {  // the header lines, where a writer on Windows would put them
+      for (const char* line : {"BINARY\n", "DATASET UNSTRUCTURED_GRID\n", "POINT_DATA 40\n", "LOOKUP_TABLE default\n"})
+        text.replace(text.find(line) + std::strlen(line) - 1, 1, "\r\n");
+    }
+    expectRoundTrip(text, xyz, {id}, binary ? "binary" : "ascii", 16);
+  }
 }
 
 // ---- Not particles, and messages ----

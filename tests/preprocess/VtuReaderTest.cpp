@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
+#include <ctime>
 
 #include "ParticleTestSupport.h"
 #include "VtkTestWriter.h"
@@ -301,6 +303,42 @@ TEST(VtuReader, DamagedFilesAreRefused) {
         if (::testing::Test::HasFailure()) return;
       }
     std::printf("%s: %zu bytes, %zu of %zu changes refused\n", describe(o).c_str(), full.size(), refused, tries);
+  }
+}
+
+// ---- Throughput (run by hand: --gtest_also_run_disabled_tests) ----
+
+TEST(VtuReader, DISABLED_Throughput) {
+  const std::size_t n = 5'000'000;
+  testing::TempDir dir("vtu-throughput");
+  std::vector<double> xyz(3 * n), v(3 * n);
+  for (std::size_t i = 0; i < 3 * n; ++i) {
+    xyz[i] = float(i % 1000) * 0.01f;
+    v[i] = float(i % 77) * 0.1f;
+  }
+  const std::vector<VtkTestArray> arrays = {{"velocity", ValueType::Float32, 3, v, VtkTestArray::Kind::Field, {}}};
+  for (auto [data, zlib, label] : {std::tuple{Data::AppendedRaw, false, "appended raw"},
+                                   {Data::Binary, false, "inline base64"},
+                                   {Data::AppendedRaw, true, "appended raw, zlib"}}) {
+    VtuOptions o;
+    o.data = data;
+    o.zlib = zlib;
+    o.cells = false;
+    testing::writeBytes(dir / "big.vtu", testing::vtu(xyz, arrays, o));
+    double bestWall = 1e30, bestCpu = 1e30;
+    for (int run = 0; run < 3; ++run) {
+      const auto start = std::chrono::steady_clock::now();
+      const std::clock_t cpuStart = std::clock();
+      auto source = openParticleFile(dir / "big.vtu");
+      ParticleChunk chunk;
+      std::size_t total = 0;
+      while (source->read(chunk, 1 << 20)) total += chunk.size();
+      EXPECT_EQ(total, n);
+      bestCpu = std::min(bestCpu, double(std::clock() - cpuStart) / CLOCKS_PER_SEC);
+      bestWall = std::min(bestWall, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    }
+    std::printf("%-28s %7.1f M particles/s wall, %7.1f M particles/s CPU (positions + velocity)\n", label,
+                double(n) / bestWall / 1e6, double(n) / bestCpu / 1e6);
   }
 }
 
