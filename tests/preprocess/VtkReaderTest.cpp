@@ -287,6 +287,28 @@ TEST(VtkLegacyReader, CarriageReturnLineBreaks) {
   }
 }
 
+TEST(VtkLegacyReader, LookupTablesTensorsAndIds) {
+  const std::string text =
+      "# vtk DataFile Version 3.0\nt\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 2 double\n0 1 2 3 4 5\n"
+      "CELLS 1 3\n2 0 1\nCELL_TYPES 1\n3\nCELL_DATA 1\nSCALARS c float\nLOOKUP_TABLE default\n7\n"
+      "POINT_DATA 2\nSCALARS s float 1\nLOOKUP_TABLE colors\n0.5 1\nLOOKUP_TABLE colors 2\n0 0 0 1\n1 1 1 1\n"
+      "TENSORS stress double\n1 2 3 4 5 6 7 8 9\n9 8 7 6 5 4 3 2 1\nGLOBAL_IDS gid vtkIdType\n10 11\n"
+      "METADATA\nINFORMATION 0\n\nCOLOR_SCALARS rgb 3\n0 0.5 1\n1 1 1\nFIELD f 2\nNULL_ARRAY\nm 1 2 float\n-1 -2\n";
+  auto source = openParticleBytes("t.vtk", bytesOf(text), everyAttribute());
+  EXPECT_EQ(source->attributes(), (std::vector<AttributeDesc>{{"s", ValueType::Float32, 1},
+                                                              {"stress", ValueType::Float64, 9},
+                                                              {"gid", ValueType::Int32, 1},
+                                                              {"rgb", ValueType::Float32, 3},
+                                                              {"m", ValueType::Float32, 1}}));
+  const Everything all = readEverything(*source, 1);
+  ASSERT_EQ(all.particles.size(), 2u);
+  EXPECT_EQ(all.columns[0], (std::vector<float>{0.5f, 1.f}));
+  EXPECT_EQ(all.columns[1][17], 1.f);
+  EXPECT_EQ(all.columns[2], (std::vector<float>{10.f, 11.f}));
+  EXPECT_EQ(all.columns[3][1], 0.5f);
+  EXPECT_EQ(all.columns[4], (std::vector<float>{-1.f, -2.f}));
+}
+
 // ---- Not particles, and messages ----
 
 TEST(VtkLegacyReader, GridsAreNotParticles) {

@@ -187,6 +187,38 @@ TEST(VtuReader, SpacesCommentsAndInformationKeys) {
   EXPECT_EQ(all.columns[0], (std::vector<float>{1.5f, -20.f}));
 }
 
+TEST(VtuReader, WrappedBase64) {
+  const auto xyz = testing::vtkTestPositions(500, 49);
+  const auto arrays = vtuArrays(500);
+  for (bool zlib : {false, true}) {
+    VtuOptions o;
+    o.data = Data::Binary;
+    o.zlib = zlib;
+    o.blockSize = 1000;
+    std::string text = testing::vtu(xyz, arrays, o);
+    // Lines of 76 characters (and a few spaces), as other writers wrap base64.
+    std::string wrapped;
+    std::size_t column = 0;
+    bool inside = false;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+      if (text.compare(i, 17, "format=\"binary\">\n") == 0) {
+        wrapped += text.substr(i, 17);
+        i += 16;
+        inside = true;
+        continue;
+      }
+      if (text[i] == '<' && inside && text.compare(i, 12, "</DataArray>") == 0) inside = false;
+      wrapped += text[i];
+      if (inside && text[i] != '\n' && ++column % 76 == 0) wrapped += column % 760 == 0 ? " \r\n\t" : "\n";
+    }
+    auto source = openParticleBytes("w.vtu", bytesOf(wrapped), everyAttribute());
+    const Everything all = readEverything(*source, 128);
+    ASSERT_EQ(all.particles.size(), 500u);
+    EXPECT_EQ(all.particles.positions[499], glm::vec3(float(xyz[1497]), float(xyz[1498]), float(xyz[1499])));
+    EXPECT_EQ(all.columns[2][321], float(arrays[2].values[321]));
+  }
+}
+
 // ---- Not particles, and messages ----
 
 TEST(VtuReader, GridsAndParallelFilesAreRefused) {
