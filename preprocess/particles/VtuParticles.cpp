@@ -298,7 +298,7 @@ class XmlLayoutParser {
         closed = mStack.empty();
         continue;
       }
-      if (tag.name == "AppendedData" && mStack.back().role == Role::File) {
+      if (tag.name == "AppendedData" && tag.kind == XmlTag::Kind::Start && mStack.back().role == Role::File) {
         appendedData(tag);
         break;
       }
@@ -443,7 +443,6 @@ class XmlLayoutParser {
   }
 
   void appendedData(const XmlTag& tag) {
-    if (tag.kind == XmlTag::Kind::Empty) return;
     const std::string* encoding = tag.find("encoding");
     if (!encoding || (*encoding != "raw" && *encoding != "base64"))
       fail("<AppendedData> at byte " + std::to_string(tag.offset) + " has encoding '" +
