@@ -19,6 +19,8 @@ const std::vector<ParticleFormat>& formatTable() {
       {"vdb", "OpenVDB points (PointDataGrid)", {".vdb"}, detail::isVdb, detail::openVdbPoints, detail::createVdbWriter},
       {"ply", "PLY polygon file, vertices as points", {".ply"}, detail::isPly, detail::openPlyParticles,
        detail::createPlyWriter},
+      {"vtk", "VTK legacy", {".vtk"}, detail::isVtkLegacy, detail::openVtkLegacyParticles, nullptr},
+      {"vtu", "VTK XML unstructured grid", {".vtu", ".vtp"}, detail::isVtkXml, detail::openVtkXmlParticles, nullptr},
       // No magic: recognised by name only, so it stays last.
       {"raw", "raw little-endian float32 xyz", {".bin", ".raw"}, nullptr, detail::openRawParticles,
        detail::createRawWriter},

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -29,6 +30,17 @@ std::unique_ptr<ParticleWriter> createPlyWriter(const std::filesystem::path& pat
 bool isVdb(std::span<const std::byte> head);
 std::unique_ptr<ParticleSource> openVdbPoints(InputFile file, const ReadOptions& options);
 std::unique_ptr<ParticleWriter> createVdbWriter(const std::filesystem::path& path, const WriteOptions& options);
+
+/// VTK legacy (.vtk), ASCII or BINARY, POLYDATA and UNSTRUCTURED_GRID (VtkLegacyParticles.cpp).
+bool isVtkLegacy(std::span<const std::byte> head);
+std::unique_ptr<ParticleSource> openVtkLegacyParticles(InputFile file, const ReadOptions& options);
+/// VTK XML UnstructuredGrid and PolyData (.vtu, .vtp): ascii, base64 and appended data, zlib
+/// (VtuParticles.cpp).
+bool isVtkXml(std::span<const std::byte> head);
+std::unique_ptr<ParticleSource> openVtkXmlParticles(InputFile file, const ReadOptions& options);
+/// The VTK velocity among `attributes`: the 3-component one named velocity, velocities, vel or v
+/// (in that order of preference, case-insensitively).
+std::optional<std::size_t> vtkVelocityAttribute(const std::vector<AttributeDesc>& attributes);
 
 /// Which of `available` ReadOptions asks for, as indices into `available`, in the order asked
 /// (all of them for allAttributes). Throws FileError naming `file`, the missing attribute and

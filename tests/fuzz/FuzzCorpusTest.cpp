@@ -17,6 +17,7 @@
 #include "TestSupport.h"
 #include "preprocess/particles/ParticleWriter.h"
 #include "preprocess/VdbTestFiles.h"
+#include "preprocess/VtkTestWriter.h"
 
 namespace flipscope {
 namespace {
@@ -92,6 +93,73 @@ TEST(FuzzCorpus, Write) {
             std::string("ply\nformat binary_big_endian 1.0\nelement vertex 1\nproperty double x\nproperty double y\n"
                         "property double z\nend_header\n") +
                 std::string("\x3f\xf0\0\0\0\0\0\0\x40\0\0\0\0\0\0\0\xc0\x08\0\0\0\0\0\0", 24));
+
+  // VTK legacy and XML files (tests/preprocess/VtkTestWriter.h): every data format, small.
+  {
+    using testing::VtkTestArray;
+    using Kind = VtkTestArray::Kind;
+    const std::size_t n = 12;
+    const auto xyz = testing::vtkTestPositions(n, 4);
+    const std::vector<VtkTestArray> splash = {testing::vtkTestArray("id", ValueType::UInt32, 1, n, 5, Kind::Scalars),
+                                              testing::vtkTestArray("velocity", ValueType::Float32, 3, n, 6)};
+    testing::LegacyVtkOptions legacy;
+    legacy.title = "SPlisHSPlasH particle data";
+    writeSeed(corpus / "vtk" / "binary_splash.vtk", testing::legacyVtk(xyz, splash, legacy));
+    std::vector<VtkTestArray> kinds = {
+        testing::vtkTestArray("density", ValueType::Float64, 1, n, 7, Kind::Scalars),
+        testing::vtkTestArray("v", ValueType::Float32, 3, n, 8, Kind::Vectors),
+        testing::vtkTestArray("n", ValueType::Int16, 3, n, 9, Kind::Normals),
+        testing::vtkTestArray("uv", ValueType::Float32, 2, n, 10, Kind::TextureCoordinates),
+        testing::vtkTestArray("big", ValueType::Int64, 1, n, 11),
+        testing::vtkTestArray("tag", ValueType::Int8, 2, n, 12)};
+    VtkTestArray flags = testing::vtkTestArray("flags", ValueType::UInt8, 1, n, 13);
+    for (double& v : flags.values) v = double(int(v) & 1);
+    flags.legacyTypeName = "bit";
+    kinds.push_back(flags);
+    VtkTestArray longs = testing::vtkTestArray("longs", ValueType::Int64, 1, n, 14);
+    longs.legacyTypeName = "long";
+    kinds.push_back(longs);
+    legacy.title = "every kind";
+    legacy.polydata = true;
+    legacy.datasetField = true;
+    writeSeed(corpus / "vtk" / "binary_polydata_kinds.vtk", testing::legacyVtk(xyz, kinds, legacy));
+    legacy.binary = false;
+    writeSeed(corpus / "vtk" / "ascii_polydata_kinds.vtk", testing::legacyVtk(xyz, kinds, legacy));
+    testing::LegacyVtkOptions v5;
+    v5.version = "5.1";
+    v5.metadata = true;
+    v5.cellData = true;
+    v5.pointType = ValueType::Float64;
+    writeSeed(corpus / "vtk" / "binary_v5_cells.vtk", testing::legacyVtk(xyz, splash, v5));
+    v5.binary = false;
+    writeSeed(corpus / "vtk" / "ascii_v5_cells.vtk", testing::legacyVtk(xyz, splash, v5));
+
+    using Data = testing::VtuOptions::Data;
+    struct Variant {
+      const char* name;
+      Data data;
+      bool zlib, header64, bigEndian, polyData;
+      int pieces;
+    };
+    for (const Variant& v : {Variant{"ascii.vtu", Data::Ascii, false, false, false, false, 1},
+                             Variant{"binary.vtu", Data::Binary, false, false, false, false, 1},
+                             Variant{"binary_zlib.vtu", Data::Binary, true, false, false, false, 2},
+                             Variant{"appended_raw.vtu", Data::AppendedRaw, false, true, false, false, 1},
+                             Variant{"appended_raw_zlib.vtu", Data::AppendedRaw, true, false, true, false, 1},
+                             Variant{"appended_base64_zlib.vtp", Data::AppendedBase64, true, true, false, true, 2},
+                             Variant{"appended_base64.vtp", Data::AppendedBase64, false, false, true, true, 1}}) {
+      testing::VtuOptions options;
+      options.data = v.data;
+      options.zlib = v.zlib;
+      options.header64 = v.header64;
+      options.bigEndian = v.bigEndian;
+      options.polyData = v.polyData;
+      options.pieces = v.pieces;
+      options.blockSize = 100;
+      options.pointType = v.bigEndian ? ValueType::Float64 : ValueType::Float32;
+      writeSeed(corpus / "vtu" / v.name, testing::vtu(xyz, splash, options));
+    }
+  }
 
   // OpenVDB files: every codec, compression and layout (compact: a few KB each), and Mantaflow.
   // (Not the uncompressed ones: 158 KB of internal node values, and libFuzzer's -max_len follows

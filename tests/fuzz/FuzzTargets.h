@@ -6,6 +6,7 @@
 //
 // Inputs:
 //   vdb_points, ply, raw    a particle file (read completely, at most kMaxParticles)
+//   vtk, vtu                the same, with every attribute
 //   store_header            store.fsh (parsed as is, then again with its checksum made right)
 //   frame_index             u32 n, store.fsh (n bytes), then a frame file; the index is read as
 //                           is and again with its checksum made right, then every brick decoded
@@ -47,9 +48,9 @@ struct Target {
   Result (*run)(std::span<const std::byte>);
 };
 
-inline Result readParticles(const char* name, std::span<const std::byte> input) {
+inline Result readParticles(const char* name, std::span<const std::byte> input, const ReadOptions& options = {}) {
   try {
-    auto source = openParticleBytes(name, input);
+    auto source = openParticleBytes(name, input, options);
     (void)source->countHint();
     (void)source->spacingHint();
     ParticleChunk chunk;
@@ -72,6 +73,13 @@ inline Result readParticles(const char* name, std::span<const std::byte> input) 
 inline Result vdbPoints(std::span<const std::byte> input) { return readParticles("fuzz.vdb", input); }
 inline Result ply(std::span<const std::byte> input) { return readParticles("fuzz.ply", input); }
 inline Result raw(std::span<const std::byte> input) { return readParticles("fuzz.bin", input); }
+inline ReadOptions everyAttribute() {
+  ReadOptions options;
+  options.allAttributes = true;
+  return options;
+}
+inline Result vtk(std::span<const std::byte> input) { return readParticles("fuzz.vtk", input, everyAttribute()); }
+inline Result vtu(std::span<const std::byte> input) { return readParticles("fuzz.vtu", input, everyAttribute()); }
 
 /// Overwrites the last 8 bytes with the checksum of the bytes before them.
 inline void fixTrailingChecksum(std::vector<std::byte>& bytes) {
@@ -211,6 +219,8 @@ inline constexpr Target kTargets[] = {
     {"vdb_points", vdbPoints},
     {"ply", ply},
     {"raw", raw},
+    {"vtk", vtk},
+    {"vtu", vtu},
     {"store_header", storeHeader},
     {"frame_index", frameIndex},
     {"brick_payload", brickPayload},
