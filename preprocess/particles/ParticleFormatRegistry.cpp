@@ -19,6 +19,9 @@ const std::vector<ParticleFormat>& formatTable() {
       {"vdb", "OpenVDB points (PointDataGrid)", {".vdb"}, detail::isVdb, detail::openVdbPoints, detail::createVdbWriter},
       {"ply", "PLY polygon file, vertices as points", {".ply"}, detail::isPly, detail::openPlyParticles,
        detail::createPlyWriter},
+      {"bgeo", "Houdini geometry (binary or ASCII JSON)",
+       {".bgeo", ".geo", ".bgeo.sc", ".geo.sc", ".bgeo.gz", ".geo.gz"}, detail::isHoudiniJson,
+       detail::openHoudiniJson, nullptr},
       // No magic: recognised by name only, so it stays last.
       {"raw", "raw little-endian float32 xyz", {".bin", ".raw"}, nullptr, detail::openRawParticles,
        detail::createRawWriter},
@@ -27,7 +30,9 @@ const std::vector<ParticleFormat>& formatTable() {
 }
 
 const std::vector<ContainerFormat>& containerTable() {
-  static const std::vector<ContainerFormat> table = {};
+  static const std::vector<ContainerFormat> table = {
+      {"scf1", ".sc", detail::isScf, detail::decodeScf},
+  };
   return table;
 }
 

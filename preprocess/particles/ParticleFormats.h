@@ -30,6 +30,16 @@ bool isVdb(std::span<const std::byte> head);
 std::unique_ptr<ParticleSource> openVdbPoints(InputFile file, const ReadOptions& options);
 std::unique_ptr<ParticleWriter> createVdbWriter(const std::filesystem::path& path, const WriteOptions& options);
 
+/// Houdini geometry in its modern JSON forms (houdini/): binary JSON .bgeo (magic 0x7f "NSJb")
+/// and ASCII JSON .geo, as points with their numeric point attributes.
+bool isHoudiniJson(std::span<const std::byte> head);
+std::unique_ptr<ParticleSource> openHoudiniJson(InputFile file, const ReadOptions& options);
+
+/// Houdini's "seekable compressed" container (.sc: "scf1", Blosc chunks, an index, "1fcs"),
+/// decoded with random access (houdini/ScfContainer.cpp).
+bool isScf(InputFile& file);
+std::unique_ptr<ByteSource> decodeScf(InputFile file);
+
 /// Which of `available` ReadOptions asks for, as indices into `available`, in the order asked
 /// (all of them for allAttributes). Throws FileError naming `file`, the missing attribute and
 /// what the file holds.
