@@ -253,6 +253,10 @@ std::size_t JsonReader::readUniformNumbers(NumberArray& array, float* out, std::
   }
   const std::size_t bytes = scalarBytes(type);
   if (bytes == 0) fail(array.offset, what + ": expected numbers, found a uniform array of strings");
+  if (type == jid::kReal32) {  // the common case: straight into the output
+    if (!mIn.read(out, n * 4)) truncated(what);
+    return n;
+  }
   std::size_t done = 0;
   while (done < n) {
     if (mIn.available() < bytes && !mIn.ensure(bytes)) truncated(what);

@@ -54,12 +54,30 @@ class ByteCursor {
     return true;
   }
 
-  /// Copies `n` bytes (any number) to `out`; false when the file ends first.
+  /// Copies `n` bytes (any number) to `out`; false when the file ends first. Large reads go
+  /// from the file straight to `out`.
   bool read(void* out, std::size_t n) {
     auto* dst = static_cast<std::byte*>(out);
+    const std::size_t buffered = std::min(n, available());
+    std::memcpy(dst, data(), buffered);
+    advance(buffered);
+    dst += buffered;
+    n -= buffered;
+    if (n >= mBufferBytes) {
+      if (n > remaining()) return false;
+      const std::uint64_t at = offset();
+      std::size_t done = 0;
+      while (done < n) {
+        const std::size_t got = mFile->readAt(at + done, dst + done, n - done);
+        if (got == 0) return false;
+        done += got;
+      }
+      seek(at + n);
+      return true;
+    }
     while (n > 0) {
-      if (available() == 0 && !ensure(1)) return false;
-      std::size_t k = std::min(n, available());
+      if (!ensure(std::min(n, mBufferBytes))) return false;
+      const std::size_t k = std::min(n, available());
       std::memcpy(dst, data(), k);
       advance(k);
       dst += k;
