@@ -6,6 +6,7 @@
 //
 // Inputs:
 //   vdb_points, ply, raw    a particle file (read completely, at most kMaxParticles)
+//   bgeo, bgeo_sc           a Houdini .bgeo or .geo (by content), and one in the scf1 container
 //   store_header            store.fsh (parsed as is, then again with its checksum made right)
 //   frame_index             u32 n, store.fsh (n bytes), then a frame file; the index is read as
 //                           is and again with its checksum made right, then every brick decoded
@@ -72,6 +73,8 @@ inline Result readParticles(const char* name, std::span<const std::byte> input) 
 inline Result vdbPoints(std::span<const std::byte> input) { return readParticles("fuzz.vdb", input); }
 inline Result ply(std::span<const std::byte> input) { return readParticles("fuzz.ply", input); }
 inline Result raw(std::span<const std::byte> input) { return readParticles("fuzz.bin", input); }
+inline Result bgeo(std::span<const std::byte> input) { return readParticles("fuzz.bgeo", input); }
+inline Result bgeoSc(std::span<const std::byte> input) { return readParticles("fuzz.bgeo.sc", input); }
 
 /// Overwrites the last 8 bytes with the checksum of the bytes before them.
 inline void fixTrailingChecksum(std::vector<std::byte>& bytes) {
@@ -211,6 +214,8 @@ inline constexpr Target kTargets[] = {
     {"vdb_points", vdbPoints},
     {"ply", ply},
     {"raw", raw},
+    {"bgeo", bgeo},
+    {"bgeo_sc", bgeoSc},
     {"store_header", storeHeader},
     {"frame_index", frameIndex},
     {"brick_payload", brickPayload},

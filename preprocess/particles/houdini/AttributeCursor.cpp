@@ -12,6 +12,7 @@
 namespace flipscope::detail::houdini {
 namespace {
 constexpr std::size_t kCursorBufferBytes = std::size_t(1) << 18;
+constexpr std::size_t kMinCursorBufferBytes = std::size_t(1) << 14;
 }
 
 AttributeCursor::AttributeCursor(InputFile& file, JsonEncoding encoding, const PointAttribute& attribute,
@@ -22,8 +23,11 @@ AttributeCursor::AttributeCursor(InputFile& file, JsonEncoding encoding, const P
       mWhatPages("point attribute '" + attribute.name + "' rawpagedata"),
       mWhatTuple("point attribute '" + attribute.name + "' tuple"),
       mWhatArray("point attribute '" + attribute.name + "' array") {
+  // One buffer, or a share of it a component ("arrays").
+  const std::size_t readers = std::max<std::size_t>(1, attribute.dataOffsets.size());
+  const std::size_t bufferBytes = std::max(kCursorBufferBytes / readers, kMinCursorBufferBytes);
   for (std::size_t i = 0; i < attribute.dataOffsets.size(); ++i)
-    mReaders.emplace_back(file, encoding, attribute.dataOffsets[i], kCursorBufferBytes);
+    mReaders.emplace_back(file, encoding, attribute.dataOffsets[i], bufferBytes);
   if (attribute.layout == ValueLayout::Paged) {
     bool constant = false;
     for (const auto& flags : attribute.constantPages)

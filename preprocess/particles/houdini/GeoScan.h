@@ -50,8 +50,8 @@ struct GeoLayout {
 /// Largest supported values: larger ones are refused as implausible.
 inline constexpr std::uint64_t kMaxPoints = std::uint64_t(1) << 44;
 inline constexpr int kMaxArity = 1024;
-inline constexpr std::uint64_t kMaxPageSize = std::uint64_t(1) << 20;
-inline constexpr std::uint64_t kMaxPageValues = std::uint64_t(1) << 24;  ///< pageSize * arity
+inline constexpr std::uint64_t kMaxPageSize = std::uint64_t(1) << 16;    ///< Houdini's pages hold 1024 points
+inline constexpr std::uint64_t kMaxPageValues = std::uint64_t(1) << 22;  ///< pageSize * arity
 
 /// Reads the layout of `file`, a binary JSON file (after its magic) or ASCII JSON text.
 /// Throws FileError for malformed or truncated files.
