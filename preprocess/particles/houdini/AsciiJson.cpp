@@ -13,8 +13,22 @@ namespace {
 
 constexpr std::size_t kMaxNumberChars = 64;
 
-bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == ',' || c == ':'; }
-bool isDelimiter(char c) { return isSpace(c) || c == ']' || c == '}' || c == '[' || c == '{' || c == '"'; }
+struct CharClasses {
+  bool space[256] = {}, delimiter[256] = {};
+  constexpr CharClasses() {
+    for (unsigned char c : {' ', '\t', '\n', '\r', ',', ':'}) space[c] = delimiter[c] = true;
+    for (unsigned char c : {']', '}', '[', '{', '"'}) delimiter[c] = true;
+  }
+};
+constexpr CharClasses kClasses;
+bool isSpace(char c) { return kClasses.space[static_cast<unsigned char>(c)]; }
+bool isDelimiter(char c) { return kClasses.delimiter[static_cast<unsigned char>(c)]; }
+
+/// The length of the text from `p` (of `n` bytes) to the first delimiter, or `n`.
+std::size_t undelimited(const char* p, std::size_t n, std::size_t from) {
+  while (from < n && !isDelimiter(p[from])) ++from;
+  return from;
+}
 
 /// A finite number too large or small for T: +-inf or +-0 by the sign of its exponent.
 double outOfRange(std::string_view text) {
@@ -80,11 +94,11 @@ TokenKind JsonReader::peekAscii() {
 
 bool JsonReader::readAsciiNumber(float* asFloat, Token* token) {
   std::size_t length = 0;
-  for (;;) {
-    if (length == mIn.available() && !mIn.ensure(length + 1)) break;  // the file ends after the number
-    if (isDelimiter(char(mIn.data()[length]))) break;
-    if (++length > kMaxNumberChars)
+  for (;;) {  // the text up to a delimiter or the end of the file, in the buffer
+    length = undelimited(reinterpret_cast<const char*>(mIn.data()), mIn.available(), length);
+    if (length > kMaxNumberChars)
       fail(offset(), "a number longer than " + std::to_string(kMaxNumberChars) + " characters");
+    if (length < mIn.available() || !mIn.ensure(length + 1)) break;
   }
   if (length == 0) return false;
   const char* text = reinterpret_cast<const char*>(mIn.data());
@@ -118,6 +132,22 @@ bool JsonReader::readAsciiNumber(float* asFloat, Token* token) {
       token->kind = TokenKind::Real;
       token->real = ec == std::errc() ? value : outOfRange(view);
     }
+  }
+  mIn.advance(length);
+  return true;
+}
+
+bool JsonReader::skipAsciiNumber() {
+  if (!mIn.ensure(1)) return false;
+  const char first = char(mIn.data()[0]);
+  if (!((first >= '0' && first <= '9') || first == '-' || first == 'n' || first == 'N' || first == 'i' || first == 'I'))
+    return false;
+  std::size_t length = 0;
+  for (;;) {
+    length = undelimited(reinterpret_cast<const char*>(mIn.data()), mIn.available(), length);
+    if (length > kMaxNumberChars)
+      fail(offset(), "a number longer than " + std::to_string(kMaxNumberChars) + " characters");
+    if (length < mIn.available() || !mIn.ensure(length + 1)) break;
   }
   mIn.advance(length);
   return true;

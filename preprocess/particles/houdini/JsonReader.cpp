@@ -206,7 +206,24 @@ std::uint64_t JsonReader::skipNumbers(NumberArray& array, const std::string& wha
     return count;
   }
   std::uint64_t count = 0;
-  float scratch[256];
+  if (mEncoding == JsonEncoding::Ascii) {
+    for (;;) {
+      skipAsciiSpace();
+      if (!mIn.ensure(1)) truncated(what);
+      if (char(mIn.data()[0]) == ']') {
+        mIn.advance(1);
+        return count;
+      }
+      const std::uint64_t at = offset();
+      if (!skipAsciiNumber()) {
+        Token token;
+        next(token, false);
+        fail(at, what + ": expected a number, found " + tokenKindName(token.kind));
+      }
+      ++count;
+    }
+  }
+  float scratch[1];
   for (;;) {
     if (peek() == TokenKind::ArrayEnd) {
       Token token;

@@ -161,6 +161,9 @@ class JsonReader {
   void readAsciiString(std::string* out);
   /// Reads a number's text at the offset; false if the next token is no number.
   bool readAsciiNumber(float* asFloat, Token* token);
+  /// Skips what reads as a number's text, without converting it (the first pass: the values
+  /// are converted, and checked, when read); false if the next token is no number.
+  bool skipAsciiNumber();
 
   ByteCursor mIn;
   JsonEncoding mEncoding;

@@ -31,7 +31,7 @@ constexpr unsigned char kScfFooterMagic[4] = {'1', 'f', 'c', 's'};
 constexpr std::uint64_t kHeaderBytes = 12;   ///< "scf1" and 8 bytes
 constexpr std::uint64_t kTrailerBytes = 12;  ///< index size, "1fcs"
 constexpr std::size_t kBloscHeaderBytes = 16;
-constexpr std::uint32_t kMaxChunkBytes = std::uint32_t(1) << 26;  ///< decoded; Houdini writes 1 MiB
+constexpr std::uint32_t kMaxChunkBytes = std::uint32_t(1) << 24;  ///< decoded; Houdini writes 1 MiB
 constexpr std::uint64_t kMaxIndexBytes = std::uint64_t(1) << 24;
 constexpr std::size_t kCachedChunks = 4;
 
