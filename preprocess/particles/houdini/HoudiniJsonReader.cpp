@@ -5,7 +5,9 @@
 // primitives, vertices and groups are skipped; a file whose points are only the anchors of
 // volumes, packed or quadric primitives (or that has no points) is refused, saying what it
 // holds. Memory: the layout from the scan and one read buffer (and page) a selected attribute,
-// whatever the file size; .bgeo.sc reaches this reader decoded by ScfContainer.cpp.
+// whatever the file size, in either encoding: ASCII files are read through seeks to where each
+// attribute's values start, like binary ones, so no decoded attribute is held. .bgeo.sc
+// reaches this reader decoded by ScfContainer.cpp.
 #include <algorithm>
 #include <cstring>
 #include <optional>
@@ -65,11 +67,9 @@ class HoudiniJsonReader final : public ParticleSource {
     mLayout = scanGeometry(mFile, mEncoding);
     const std::filesystem::path& path = mFile.path();
     if (mLayout.pointCount == 0)
-      throw FileError(path, "holds no points (" +
-                                (mLayout.primitiveCount == 0 && mLayout.primitiveTypes.empty()
-                                     ? std::string("an empty geometry")
-                                     : "0 points, " + describePrimitives(mLayout)) +
-                                ")");
+      throw FileError(path, mLayout.primitiveCount == 0 && mLayout.primitiveTypes.empty()
+                                ? std::string("holds no points (an empty geometry)")
+                                : "holds no points, only " + describePrimitives(mLayout));
     const bool anchorsOnly =
         !mLayout.primitiveTypes.empty() &&
         std::all_of(mLayout.primitiveTypes.begin(), mLayout.primitiveTypes.end(),
