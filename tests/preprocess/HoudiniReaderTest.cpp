@@ -573,6 +573,19 @@ TEST(HoudiniReader, MessagesSayWhatIsWrong) {
   refuse("points.geo", replaced(ascii, "\"pointcount\",3", "\"pointcount\",0"),
          {"rawpagedata holds 9 numbers, expected 0"});
 
+  // What a file without particles holds.
+  bgeo::Geometry shapes = g;
+  shapes.points = 0;
+  shapes.attributes[0].value = nullptr;
+  shapes.primitives = {"Poly"};
+  refuse("nopoints.geo", bgeo::geometryBytes(shapes, bgeo::Encoding::Ascii), {"holds no points, only 1 primitive (Poly)"});
+  shapes = g;
+  shapes.primitives = {"Volume", "PackedGeometry"};
+  refuse("anchors.bgeo", bgeo::geometryBytes(shapes, bgeo::Encoding::Binary),
+         {"holds no point cloud: only 2 primitives (Volume, PackedGeometry), whose positions are its 3 points"});
+  shapes.primitives = {"Volume", "Poly"};  // the points of a polygon: read
+  EXPECT_EQ(readBytes("mixed.bgeo", bgeo::geometryBytes(shapes, bgeo::Encoding::Binary)).positions.size(), 3u);
+
   const std::string packed = bgeo::scfContainer(binary);
   refuse("cut.bgeo.sc", packed.substr(0, packed.size() - 1), {"scf1 container without its footer"});
   std::string badIndex = packed;
