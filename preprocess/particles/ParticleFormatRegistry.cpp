@@ -21,6 +21,9 @@ const std::vector<ParticleFormat>& formatTable() {
        detail::createPlyWriter},
       {"vtk", "VTK legacy", {".vtk"}, detail::isVtkLegacy, detail::openVtkLegacyParticles, nullptr},
       {"vtu", "VTK XML unstructured grid", {".vtu", ".vtp"}, detail::isVtkXml, detail::openVtkXmlParticles, nullptr},
+      {"bgeo", "Houdini geometry (binary or ASCII JSON)",
+       {".bgeo", ".geo", ".bgeo.sc", ".geo.sc", ".bgeo.gz", ".geo.gz"}, detail::isHoudiniJson,
+       detail::openHoudiniJson, nullptr},
       // No magic: recognised by name only, so it stays last.
       {"raw", "raw little-endian float32 xyz", {".bin", ".raw"}, nullptr, detail::openRawParticles,
        detail::createRawWriter},
@@ -29,7 +32,9 @@ const std::vector<ParticleFormat>& formatTable() {
 }
 
 const std::vector<ContainerFormat>& containerTable() {
-  static const std::vector<ContainerFormat> table = {};
+  static const std::vector<ContainerFormat> table = {
+      {"scf1", ".sc", detail::isScf, detail::decodeScf},
+  };
   return table;
 }
 

@@ -41,6 +41,15 @@ std::unique_ptr<ParticleSource> openVtkXmlParticles(InputFile file, const ReadOp
 /// The VTK velocity among `attributes`: the 3-component one named velocity, velocities, vel or v
 /// (in that order of preference, case-insensitively).
 std::optional<std::size_t> vtkVelocityAttribute(const std::vector<AttributeDesc>& attributes);
+/// Houdini geometry in its modern JSON forms (houdini/): binary JSON .bgeo (magic 0x7f "NSJb")
+/// and ASCII JSON .geo, as points with their numeric point attributes.
+bool isHoudiniJson(std::span<const std::byte> head);
+std::unique_ptr<ParticleSource> openHoudiniJson(InputFile file, const ReadOptions& options);
+
+/// Houdini's "seekable compressed" container (.sc: "scf1", Blosc chunks, an index, "1fcs"),
+/// decoded with random access (houdini/ScfContainer.cpp).
+bool isScf(InputFile& file);
+std::unique_ptr<ByteSource> decodeScf(InputFile file);
 
 /// Which of `available` ReadOptions asks for, as indices into `available`, in the order asked
 /// (all of them for allAttributes). Throws FileError naming `file`, the missing attribute and

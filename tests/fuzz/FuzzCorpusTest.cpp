@@ -16,6 +16,7 @@
 #include "FuzzTargets.h"
 #include "TestSupport.h"
 #include "preprocess/particles/ParticleWriter.h"
+#include "preprocess/BgeoTestWriter.h"
 #include "preprocess/VdbTestFiles.h"
 #include "preprocess/VtkTestWriter.h"
 
@@ -158,6 +159,42 @@ TEST(FuzzCorpus, Write) {
       options.blockSize = 100;
       options.pointType = v.bigEndian ? ValueType::Float64 : ValueType::Float32;
       writeSeed(corpus / "vtu" / v.name, testing::vtu(xyz, splash, options));
+  // Houdini: a few real files (also in tests/data), and synthetic ones (BgeoTestWriter.h): pages
+  // of 8 points, packing 3+1 with a constant w, constant pages, tuples, arrays, every encoding.
+  const fs::path formats = fs::path(FLIPSCOPE_DATA_DIR) / "formats";
+  for (const char* name :
+       {"points_noprim_15.bgeo", "points_noprim_15.geo", "simple_partanim.0017.bgeo", "simple_partanim.0017.geo"})
+    fs::copy_file(formats / "houdini-modern" / name, corpus / "bgeo" / name);
+  for (const char* name : {"labs_star.1.bgeo.sc", "labs_wfc.1.bgeo.sc"})
+    fs::copy_file(formats / "houdini-bgeo-sc" / name, corpus / "bgeo_sc" / name);
+  namespace bgeo = testing::bgeo;
+  for (bool uniform : {true, false}) {
+    bgeo::Geometry g;
+    g.points = 50;
+    g.tokenStrings = uniform;
+    auto add = [&](const char* name, const char* storage, int arity, bgeo::Layout layout,
+                   std::function<double(std::uint64_t, int)> value) {
+      bgeo::Attribute a;
+      a.name = name;
+      a.storage = storage;
+      a.arity = arity;
+      a.layout = layout;
+      a.pageSize = 8;
+      a.uniform = uniform;
+      a.value = std::move(value);
+      g.attributes.push_back(std::move(a));
+    };
+    add("P", "fpreal32", 4, bgeo::Layout::Paged, [](std::uint64_t p, int c) { return c == 3 ? 1.0 : 0.1 * double(p) + c; });
+    g.attributes.back().packing = {3, 1};
+    add("v", "fpreal64", 3, bgeo::Layout::Tuples, [](std::uint64_t p, int c) { return double(p % 5) - c; });
+    add("pscale", "fpreal16", 1, bgeo::Layout::Paged, [](std::uint64_t p, int) { return p < 16 ? 0.5 : 0.25; });
+    add("id", "int32", 1, bgeo::Layout::Arrays, [](std::uint64_t p, int) { return double(p); });
+    const std::string binary = bgeo::geometryBytes(g, bgeo::Encoding::Binary);
+    const std::string v = uniform ? "uniform" : "tokens";
+    writeSeed(corpus / "bgeo" / ("synthetic_" + v + ".bgeo"), binary);
+    if (uniform) {
+      writeSeed(corpus / "bgeo" / "synthetic.geo", bgeo::geometryBytes(g, bgeo::Encoding::Ascii));
+      writeSeed(corpus / "bgeo_sc" / "synthetic_chunks.bgeo.sc", bgeo::scfContainer(binary, 700));
     }
   }
 

@@ -7,6 +7,7 @@
 // Inputs:
 //   vdb_points, ply, raw    a particle file (read completely, at most kMaxParticles)
 //   vtk, vtu                the same, with every attribute
+//   bgeo, bgeo_sc           a Houdini .bgeo or .geo (by content), and one in the scf1 container
 //   store_header            store.fsh (parsed as is, then again with its checksum made right)
 //   frame_index             u32 n, store.fsh (n bytes), then a frame file; the index is read as
 //                           is and again with its checksum made right, then every brick decoded
@@ -80,6 +81,8 @@ inline ReadOptions everyAttribute() {
 }
 inline Result vtk(std::span<const std::byte> input) { return readParticles("fuzz.vtk", input, everyAttribute()); }
 inline Result vtu(std::span<const std::byte> input) { return readParticles("fuzz.vtu", input, everyAttribute()); }
+inline Result bgeo(std::span<const std::byte> input) { return readParticles("fuzz.bgeo", input, everyAttribute()); }
+inline Result bgeoSc(std::span<const std::byte> input) { return readParticles("fuzz.bgeo.sc", input, everyAttribute()); }
 
 /// Overwrites the last 8 bytes with the checksum of the bytes before them.
 inline void fixTrailingChecksum(std::vector<std::byte>& bytes) {
@@ -221,6 +224,8 @@ inline constexpr Target kTargets[] = {
     {"raw", raw},
     {"vtk", vtk},
     {"vtu", vtu},
+    {"bgeo", bgeo},
+    {"bgeo_sc", bgeoSc},
     {"store_header", storeHeader},
     {"frame_index", frameIndex},
     {"brick_payload", brickPayload},

@@ -22,7 +22,7 @@ rm -rf "$work"
 mkdir -p "$work"
 summary=""
 failed=""
-for pair in vdb_points:VdbPoints ply:Ply raw:Raw vtk:Vtk vtu:Vtu store_header:StoreHeader frame_index:FrameIndex \
+for pair in vdb_points:VdbPoints ply:Ply raw:Raw vtk:Vtk vtu:Vtu bgeo:Bgeo bgeo_sc:BgeoSc store_header:StoreHeader frame_index:FrameIndex \
   brick_payload:BrickPayload camera:Camera; do
   name=${pair%%:*}
   binary="$build/tests/fuzz/${pair#*:}Fuzz"

@@ -1,0 +1,12 @@
+// libFuzzer target: Houdini's scf1 container (.bgeo.sc) and the geometry inside. Input format
+// and body: FuzzTargets.h.
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "FuzzTargets.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  flipscope::fuzz::bgeoSc(std::as_bytes(std::span(data, size)));
+  return 0;
+}
