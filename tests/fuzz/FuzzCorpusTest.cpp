@@ -159,6 +159,9 @@ TEST(FuzzCorpus, Write) {
       options.blockSize = 100;
       options.pointType = v.bigEndian ? ValueType::Float64 : ValueType::Float32;
       writeSeed(corpus / "vtu" / v.name, testing::vtu(xyz, splash, options));
+    }
+  }
+
   // Houdini: a few real files (also in tests/data), and synthetic ones (BgeoTestWriter.h): pages
   // of 8 points, packing 3+1 with a constant w, constant pages, tuples, arrays, every encoding.
   const fs::path formats = fs::path(FLIPSCOPE_DATA_DIR) / "formats";
