@@ -19,6 +19,12 @@ const std::vector<ParticleFormat>& formatTable() {
       {"vdb", "OpenVDB points (PointDataGrid)", {".vdb"}, detail::isVdb, detail::openVdbPoints, detail::createVdbWriter},
       {"ply", "PLY polygon file, vertices as points", {".ply"}, detail::isPly, detail::openPlyParticles,
        detail::createPlyWriter},
+      {"bgeo-classic", "Houdini classic geometry (BgeoV / PGEOMETRY)", {".bgeo", ".geo", ".bgeo.gz", ".geo.gz"},
+       detail::isClassicBgeo, detail::openClassicBgeo, nullptr},
+      {"prt", "Krakatoa PRT particles", {".prt"}, detail::isPrt, detail::openPrtParticles, nullptr},
+      // By content only (magic 0xFABADA): a ".bin" name means raw floats, below.
+      {"realflow-bin", "RealFlow particle cache (.bin, recognised by content)", {}, detail::isRealFlowBin,
+       detail::openRealFlowParticles, nullptr},
       // No magic: recognised by name only, so it stays last.
       {"raw", "raw little-endian float32 xyz", {".bin", ".raw"}, nullptr, detail::openRawParticles,
        detail::createRawWriter},
@@ -27,7 +33,9 @@ const std::vector<ParticleFormat>& formatTable() {
 }
 
 const std::vector<ContainerFormat>& containerTable() {
-  static const std::vector<ContainerFormat> table = {};
+  static const std::vector<ContainerFormat> table = {
+      {"gzip", ".gz", detail::isGzip, detail::decodeGzip},
+  };
   return table;
 }
 
