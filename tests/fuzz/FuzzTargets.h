@@ -6,6 +6,8 @@
 //
 // Inputs:
 //   vdb_points, ply, raw    a particle file (read completely, at most kMaxParticles)
+//   classic_bgeo, prt,      a particle file, read with every attribute: Houdini classic
+//   realflow_bin, gzip      geometry, Krakatoa PRT, RealFlow .bin, and any of them gzipped
 //   store_header            store.fsh (parsed as is, then again with its checksum made right)
 //   frame_index             u32 n, store.fsh (n bytes), then a frame file; the index is read as
 //                           is and again with its checksum made right, then every brick decoded
@@ -47,9 +49,11 @@ struct Target {
   Result (*run)(std::span<const std::byte>);
 };
 
-inline Result readParticles(const char* name, std::span<const std::byte> input) {
+inline Result readParticles(const char* name, std::span<const std::byte> input, bool allAttributes = false) {
   try {
-    auto source = openParticleBytes(name, input);
+    ReadOptions options;
+    options.allAttributes = allAttributes;
+    auto source = openParticleBytes(name, input, options);
     (void)source->countHint();
     (void)source->spacingHint();
     ParticleChunk chunk;
@@ -59,6 +63,9 @@ inline Result readParticles(const char* name, std::span<const std::byte> input) 
         total += chunk.size();
         if (chunk.velocities.size() != (source->hasVelocity() ? chunk.size() : 0))
           throw LogicError("chunk velocities do not match hasVelocity()");
+        for (const auto& column : chunk.attributes)
+          if (column.values.size() != chunk.size() * std::size_t(column.arity))
+            throw LogicError("attribute column '" + column.name + "' does not match the chunk");
         if (pass == 1 && total > 3000) break;
       }
       source->rewind();
@@ -72,6 +79,10 @@ inline Result readParticles(const char* name, std::span<const std::byte> input) 
 inline Result vdbPoints(std::span<const std::byte> input) { return readParticles("fuzz.vdb", input); }
 inline Result ply(std::span<const std::byte> input) { return readParticles("fuzz.ply", input); }
 inline Result raw(std::span<const std::byte> input) { return readParticles("fuzz.bin", input); }
+inline Result classicBgeo(std::span<const std::byte> input) { return readParticles("fuzz.bgeo", input, true); }
+inline Result prt(std::span<const std::byte> input) { return readParticles("fuzz.prt", input, true); }
+inline Result realFlowBin(std::span<const std::byte> input) { return readParticles("fuzz.bin", input, true); }
+inline Result gzip(std::span<const std::byte> input) { return readParticles("fuzz.gz", input, true); }
 
 /// Overwrites the last 8 bytes with the checksum of the bytes before them.
 inline void fixTrailingChecksum(std::vector<std::byte>& bytes) {
@@ -211,6 +222,10 @@ inline constexpr Target kTargets[] = {
     {"vdb_points", vdbPoints},
     {"ply", ply},
     {"raw", raw},
+    {"classic_bgeo", classicBgeo},
+    {"prt", prt},
+    {"realflow_bin", realFlowBin},
+    {"gzip", gzip},
     {"store_header", storeHeader},
     {"frame_index", frameIndex},
     {"brick_payload", brickPayload},

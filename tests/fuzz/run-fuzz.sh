@@ -23,7 +23,7 @@ mkdir -p "$work"
 summary=""
 failed=""
 for pair in vdb_points:VdbPoints ply:Ply raw:Raw store_header:StoreHeader frame_index:FrameIndex \
-  brick_payload:BrickPayload camera:Camera; do
+  brick_payload:BrickPayload camera:Camera classic_bgeo:ClassicBgeo prt:Prt realflow_bin:RealFlow gzip:Gzip; do
   name=${pair%%:*}
   binary="$build/tests/fuzz/${pair#*:}Fuzz"
   mkdir -p "$work/$name"
