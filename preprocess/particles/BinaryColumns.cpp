@@ -59,17 +59,28 @@ template <bool Swap>
 void decodeOrdered(ValueType type, const std::byte* first, std::size_t stride, int arity, std::size_t count,
                    float* out) {
   switch (type) {
-    case ValueType::Int8: return decodeTyped<std::int8_t, Swap>(first, stride, arity, count, out);
-    case ValueType::UInt8: return decodeTyped<std::uint8_t, Swap>(first, stride, arity, count, out);
-    case ValueType::Int16: return decodeTyped<std::int16_t, Swap>(first, stride, arity, count, out);
-    case ValueType::UInt16: return decodeTyped<std::uint16_t, Swap>(first, stride, arity, count, out);
-    case ValueType::Int32: return decodeTyped<std::int32_t, Swap>(first, stride, arity, count, out);
-    case ValueType::UInt32: return decodeTyped<std::uint32_t, Swap>(first, stride, arity, count, out);
-    case ValueType::Int64: return decodeTyped<std::int64_t, Swap>(first, stride, arity, count, out);
-    case ValueType::UInt64: return decodeTyped<std::uint64_t, Swap>(first, stride, arity, count, out);
-    case ValueType::Float16: return decodeTyped<Half, Swap>(first, stride, arity, count, out);
-    case ValueType::Float32: return decodeTyped<float, Swap>(first, stride, arity, count, out);
-    case ValueType::Float64: return decodeTyped<double, Swap>(first, stride, arity, count, out);
+    case ValueType::Int8:
+      return decodeTyped<std::int8_t, Swap>(first, stride, arity, count, out);
+    case ValueType::UInt8:
+      return decodeTyped<std::uint8_t, Swap>(first, stride, arity, count, out);
+    case ValueType::Int16:
+      return decodeTyped<std::int16_t, Swap>(first, stride, arity, count, out);
+    case ValueType::UInt16:
+      return decodeTyped<std::uint16_t, Swap>(first, stride, arity, count, out);
+    case ValueType::Int32:
+      return decodeTyped<std::int32_t, Swap>(first, stride, arity, count, out);
+    case ValueType::UInt32:
+      return decodeTyped<std::uint32_t, Swap>(first, stride, arity, count, out);
+    case ValueType::Int64:
+      return decodeTyped<std::int64_t, Swap>(first, stride, arity, count, out);
+    case ValueType::UInt64:
+      return decodeTyped<std::uint64_t, Swap>(first, stride, arity, count, out);
+    case ValueType::Float16:
+      return decodeTyped<Half, Swap>(first, stride, arity, count, out);
+    case ValueType::Float32:
+      return decodeTyped<float, Swap>(first, stride, arity, count, out);
+    case ValueType::Float64:
+      return decodeTyped<double, Swap>(first, stride, arity, count, out);
   }
   FLIPSCOPE_CHECK(false, "unknown value type " << int(type));
 }
@@ -79,16 +90,20 @@ void decodeOrdered(ValueType type, const std::byte* first, std::size_t stride, i
 std::size_t valueTypeBytes(ValueType type) {
   switch (type) {
     case ValueType::Int8:
-    case ValueType::UInt8: return 1;
+    case ValueType::UInt8:
+      return 1;
     case ValueType::Int16:
     case ValueType::UInt16:
-    case ValueType::Float16: return 2;
+    case ValueType::Float16:
+      return 2;
     case ValueType::Int32:
     case ValueType::UInt32:
-    case ValueType::Float32: return 4;
+    case ValueType::Float32:
+      return 4;
     case ValueType::Int64:
     case ValueType::UInt64:
-    case ValueType::Float64: return 8;
+    case ValueType::Float64:
+      return 8;
   }
   FLIPSCOPE_CHECK(false, "unknown value type " << int(type));
   return 0;

@@ -99,10 +99,10 @@ class GzipByteSource final : public ByteSource {
         mInputOffset += mInputFill;
         mInputFill = mFile.readAt(mInputOffset, mInput.data(), mInput.size());
         if (mInputFill == 0)
-          throw FileError(mFile.path(),
-                          "truncated gzip data: the file ends at byte " + std::to_string(mInputOffset) +
-                              " inside the gzip member that starts at byte " + std::to_string(mMemberStart) + " (" +
-                              std::to_string(mDecoded + (asked - mStream.avail_out)) + " bytes decoded)");
+          throw FileError(mFile.path(), "truncated gzip data: the file ends at byte " + std::to_string(mInputOffset) +
+                                            " inside the gzip member that starts at byte " +
+                                            std::to_string(mMemberStart) + " (" +
+                                            std::to_string(mDecoded + (asked - mStream.avail_out)) + " bytes decoded)");
         mStream.next_in = mInput.data();
         mStream.avail_in = uInt(mInputFill);
       }
@@ -111,8 +111,8 @@ class GzipByteSource final : public ByteSource {
         nextMember();
       } else if (status != Z_OK) {
         const std::string reason = status == Z_MEM_ERROR ? "out of memory"
-                                   : mStream.msg          ? mStream.msg
-                                                          : "error " + std::to_string(status);
+                                   : mStream.msg         ? mStream.msg
+                                                         : "error " + std::to_string(status);
         throw FileError(mFile.path(), "damaged gzip data near compressed byte " + std::to_string(compressedOffset()) +
                                           " (member starting at byte " + std::to_string(mMemberStart) +
                                           ", zlib: " + reason + ")");

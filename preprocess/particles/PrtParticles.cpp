@@ -8,8 +8,8 @@
 // uint16, 7 uint32, 8 uint64, 9 int8, 10 uint8), arity, byte offset in a particle. The
 // particles follow as one zlib stream (RFC 1950, not gzip) of packed records.
 //
-// The stream is inflated chunk by chunk straight into the records of the chunk (memory: the
-// chunk, plus at most 16 MiB of records and 256 KiB of input). "Position" (3 floats of any
+// The stream is inflated a batch of records at a time (1 MiB, decoded while it is in cache) into
+// the chunk (memory: the chunk, the batch and 256 KiB of input). "Position" (3 floats of any
 // width) gives the positions, "Velocity" (3 values) the velocities; every channel but Position
 // is an attribute. A count of -1 is read as "until the stream ends" (countHint() is then
 // unknown); a known count must match the stream exactly.
@@ -37,7 +37,7 @@ constexpr std::uint64_t kBaseHeaderBytes = 56;
 constexpr std::uint64_t kChannelBytes = 44;
 constexpr std::int32_t kMaxChannels = 1 << 16;
 constexpr std::size_t kMaxRecordBytes = std::size_t(1) << 24;
-constexpr std::size_t kBatchBytes = std::size_t(16) << 20;
+constexpr std::size_t kBatchBytes = std::size_t(1) << 20;
 constexpr std::size_t kInputBytes = 256 * 1024;
 
 constexpr ValueType kPrtTypes[] = {ValueType::Int16,   ValueType::Int32,   ValueType::Int64,  ValueType::Float16,
@@ -283,8 +283,8 @@ class PrtReader final : public ParticleSource {
         if (status == Z_STREAM_END)
           streamEnded();
         else if (status != Z_OK)
-          throw fail("damaged zlib particle data near byte " + std::to_string(compressedOffset()) + " (zlib: " +
-                     (mStream.msg ? std::string(mStream.msg) : "error " + std::to_string(status)) + ")");
+          throw fail("damaged zlib particle data near byte " + std::to_string(compressedOffset()) +
+                     " (zlib: " + (mStream.msg ? std::string(mStream.msg) : "error " + std::to_string(status)) + ")");
       }
       done += want - mStream.avail_out;
     }

@@ -19,8 +19,9 @@
 // RealFlow itself 10), so it is checked as far as it is understood and taken on trust beyond
 // (additional data, internal data that is not empty).
 //
-// The records are read in chunks (memory: the chunk, plus at most 16 MiB of records); the
-// trailing section is checked once the last particle has been read.
+// The records are read in chunks, 1 MiB of records at a time, decoded while they are in cache
+// (memory: the chunk and that 1 MiB); the trailing section is checked once the last particle has
+// been read.
 #include <algorithm>
 #include <bit>
 #include <cstring>
@@ -38,7 +39,7 @@ static_assert(std::endian::native == std::endian::little, "fields are read as st
 constexpr std::uint32_t kMagic = 0x00FABADA;
 constexpr std::size_t kNameBytes = 250;
 constexpr int kMaxVersion = 12;
-constexpr std::size_t kBatchBytes = std::size_t(16) << 20;
+constexpr std::size_t kBatchBytes = std::size_t(1) << 20;
 
 struct RealFlowField {
   const char* name;
@@ -106,9 +107,9 @@ class RealFlowReader final : public ParticleSource {
 
     const std::uint64_t available = (mFile.size() - mDataOffset) / mStride;
     if (available < mCount)
-      throw fail("truncated: the file ends at particle " + std::to_string(available) + " of " +
-                 std::to_string(mCount) + " (particles start at byte " + std::to_string(mDataOffset) + ", " +
-                 std::to_string(mStride) + " bytes a particle, file size " + std::to_string(mFile.size()) + ")");
+      throw fail("truncated: the file ends at particle " + std::to_string(available) + " of " + std::to_string(mCount) +
+                 " (particles start at byte " + std::to_string(mDataOffset) + ", " + std::to_string(mStride) +
+                 " bytes a particle, file size " + std::to_string(mFile.size()) + ")");
     mSelected = selectAttributes(mExposed, options, mFile.path());
     mColumns = makeColumns(mExposed, mSelected);
     mHasVelocity = options.velocity;
@@ -139,8 +140,8 @@ class RealFlowReader final : public ParticleSource {
       const std::size_t count = std::min(batch, n - begin);
       mBuffer.resize(count * mStride);
       if (mFile.read(mBuffer.data(), mBuffer.size()) != mBuffer.size())
-        throw fail("the file ends inside particle " + std::to_string(mNext + begin) + " of " +
-                   std::to_string(mCount) + " (was it truncated while being read?)");
+        throw fail("the file ends inside particle " + std::to_string(mNext + begin) + " of " + std::to_string(mCount) +
+                   " (was it truncated while being read?)");
       const std::byte* records = mBuffer.data();
       decodeVec3Column(mPosition.type, ByteOrder::Little, records + mPosition.offset, mStride, count,
                        chunk.positions.data() + begin);

@@ -1,4 +1,5 @@
-// libFuzzer target: the Houdini classic geometry reader (houdini/ClassicBgeo*.cpp). Input format and body: FuzzTargets.h.
+// libFuzzer target: the Houdini classic geometry reader (houdini/ClassicBgeo*.cpp). Input format and body:
+// FuzzTargets.h.
 #include <cstddef>
 #include <cstdint>
 #include <span>

@@ -1,4 +1,5 @@
-// libFuzzer target: the gzip container (GzipContainer.cpp) around any particle file. Input format and body: FuzzTargets.h.
+// libFuzzer target: the gzip container (GzipContainer.cpp) around any particle file. Input format and body:
+// FuzzTargets.h.
 #include <cstddef>
 #include <cstdint>
 #include <span>

@@ -132,11 +132,16 @@ const std::vector<testing::BgeoAttributeSpec> kAttributes = {
 float position(std::size_t p, int axis) { return float(p) * 0.25f - 100.f + float(axis) * 1.5f; }
 double value(std::size_t p, std::size_t attribute, int c) {
   switch (attribute) {
-    case 0: return 0.5 + double(p % 7);
-    case 1: return double(p) * 0.125 * (c + 1) - 3;
-    case 2: return double(p) - 50;
-    case 3: return double(p % 2);
-    default: return double(c) - double(p) * 0.5;
+    case 0:
+      return 0.5 + double(p % 7);
+    case 1:
+      return double(p) * 0.125 * (c + 1) - 3;
+    case 2:
+      return double(p) - 50;
+    case 3:
+      return double(p % 2);
+    default:
+      return double(c) - double(p) * 0.5;
   }
 }
 
@@ -159,8 +164,8 @@ void expectRoundTrip(const std::string& name, const std::string& bytes, std::siz
       ASSERT_EQ(all.particles.size(), count);
       for (std::size_t p = 0; p < count; ++p) {
         ASSERT_EQ(all.particles.positions[p], glm::vec3(position(p, 0), position(p, 1), position(p, 2))) << p;
-        ASSERT_EQ(all.particles.velocities[p], glm::vec3(float(value(p, 1, 0)), float(value(p, 1, 1)),
-                                                         float(value(p, 1, 2))));
+        ASSERT_EQ(all.particles.velocities[p],
+                  glm::vec3(float(value(p, 1, 0)), float(value(p, 1, 1)), float(value(p, 1, 2))));
         ASSERT_EQ(all.attributes.at("pscale")[p], float(value(p, 0, 0)));
         ASSERT_EQ(all.attributes.at("id")[p], float(value(p, 2, 0)));
         ASSERT_EQ(all.attributes.at("uv")[2 * p + 1], float(value(p, 4, 1)));

@@ -77,7 +77,8 @@ TEST(GzipContainer, RandomAccessForwardsAndBackwards) {
 TEST(GzipContainer, NestedTwiceAtMost) {
   TempDir dir("gzip-nested");
   const std::string bgeo = testing::makeClassicBgeo(
-      20, {}, [](std::size_t p, int c) { return float(p + std::size_t(c)); }, [](std::size_t, std::size_t, int) { return 0.0; });
+      20, {}, [](std::size_t p, int c) { return float(p + std::size_t(c)); },
+      [](std::size_t, std::size_t, int) { return 0.0; });
   testing::writeBytes(dir / "two.bgeo.gz", testing::gzip(testing::gzip(bgeo)));
   EXPECT_EQ(testing::readFile(dir / "two.bgeo.gz").size(), 20u);
   testing::writeBytes(dir / "three.bgeo.gz", testing::gzip(testing::gzip(testing::gzip(bgeo))));

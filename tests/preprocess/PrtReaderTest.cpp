@@ -34,9 +34,8 @@ TEST(PrtReader, RealFiles) {
   EXPECT_EQ(source->format(), "Krakatoa PRT 1.1 (header version 2)");
   EXPECT_EQ(source->countHint(), 312u);
   EXPECT_TRUE(source->hasVelocity());
-  const std::vector<AttributeDesc> expected = {{"Color", ValueType::Float32, 3},
-                                               {"Velocity", ValueType::Float32, 3},
-                                               {"Density", ValueType::Float32, 1}};
+  const std::vector<AttributeDesc> expected = {
+      {"Color", ValueType::Float32, 3}, {"Velocity", ValueType::Float32, 3}, {"Density", ValueType::Float32, 1}};
   EXPECT_EQ(source->attributes(), expected);
   ParticleChunk all, chunk;
   std::vector<float> density;
@@ -60,23 +59,34 @@ TEST(PrtReader, RealFiles) {
 double exactValue(PrtType type, std::size_t p, std::size_t i, int c) {
   const double k = double((p * 7 + i * 13 + std::size_t(c) * 5) % 97);
   switch (type) {
-    case PrtType::Int8: return k - 48;
-    case PrtType::UInt8: return k + 150;
-    case PrtType::Int16: return (k - 48) * 600;
-    case PrtType::UInt16: return k * 650;
-    case PrtType::Int32: return (k - 48) * 40000000;
-    case PrtType::UInt32: return k * 40000000;
-    case PrtType::Int64: return (k - 48) * 1099511627776.0;  // k * 2^40: exact in float
-    case PrtType::UInt64: return k * 1099511627776.0 * 1024;
-    case PrtType::Float16: return (k - 48) * 0.5;
-    case PrtType::Float32: return (k - 48) * 0.375 + double(p);
-    case PrtType::Float64: return (k - 48) * 0.0625 - double(p) * 2;
+    case PrtType::Int8:
+      return k - 48;
+    case PrtType::UInt8:
+      return k + 150;
+    case PrtType::Int16:
+      return (k - 48) * 600;
+    case PrtType::UInt16:
+      return k * 650;
+    case PrtType::Int32:
+      return (k - 48) * 40000000;
+    case PrtType::UInt32:
+      return k * 40000000;
+    case PrtType::Int64:
+      return (k - 48) * 1099511627776.0;  // k * 2^40: exact in float
+    case PrtType::UInt64:
+      return k * 1099511627776.0 * 1024;
+    case PrtType::Float16:
+      return (k - 48) * 0.5;
+    case PrtType::Float32:
+      return (k - 48) * 0.375 + double(p);
+    case PrtType::Float64:
+      return (k - 48) * 0.0625 - double(p) * 2;
   }
   return 0;
 }
 
-constexpr PrtType kAllTypes[] = {PrtType::Int8,   PrtType::UInt8,  PrtType::Int16,   PrtType::UInt16,
-                                 PrtType::Int32,  PrtType::UInt32, PrtType::Int64,   PrtType::UInt64,
+constexpr PrtType kAllTypes[] = {PrtType::Int8,    PrtType::UInt8,   PrtType::Int16,  PrtType::UInt16,
+                                 PrtType::Int32,   PrtType::UInt32,  PrtType::Int64,  PrtType::UInt64,
                                  PrtType::Float16, PrtType::Float32, PrtType::Float64};
 
 TEST(PrtReader, EveryTypeAndArityRoundTrips) {
@@ -207,7 +217,7 @@ TEST(HalfFloat, EveryClassOfValue) {
   EXPECT_TRUE(std::signbit(halfToFloat(0x8000)));
   EXPECT_EQ(halfToFloat(0x3c00), 1.f);
   EXPECT_EQ(halfToFloat(0xc000), -2.f);
-  EXPECT_EQ(halfToFloat(0x7bff), 65504.f);             // largest finite
+  EXPECT_EQ(halfToFloat(0x7bff), 65504.f);               // largest finite
   EXPECT_EQ(halfToFloat(0x0400), std::ldexp(1.f, -14));  // smallest normal
   EXPECT_EQ(halfToFloat(0x0001), std::ldexp(1.f, -24));  // smallest subnormal
   EXPECT_EQ(halfToFloat(0x03ff), std::ldexp(1023.f, -24));

@@ -18,20 +18,34 @@ namespace flipscope::testing {
 
 /// PRT data types, as the file numbers them.
 enum class PrtType : std::int32_t {
-  Int16 = 0, Int32, Int64, Float16, Float32, Float64, UInt16, UInt32, UInt64, Int8, UInt8
+  Int16 = 0,
+  Int32,
+  Int64,
+  Float16,
+  Float32,
+  Float64,
+  UInt16,
+  UInt32,
+  UInt64,
+  Int8,
+  UInt8
 };
 
 inline std::size_t prtTypeBytes(PrtType type) {
   switch (type) {
     case PrtType::Int8:
-    case PrtType::UInt8: return 1;
+    case PrtType::UInt8:
+      return 1;
     case PrtType::Int16:
     case PrtType::UInt16:
-    case PrtType::Float16: return 2;
+    case PrtType::Float16:
+      return 2;
     case PrtType::Int32:
     case PrtType::UInt32:
-    case PrtType::Float32: return 4;
-    default: return 8;
+    case PrtType::Float32:
+      return 4;
+    default:
+      return 8;
   }
 }
 
@@ -67,25 +81,47 @@ struct PrtChannelSpec {
 inline void putPrtValue(PrtType type, double value, unsigned char* out) {
   auto put = [&](auto v) { std::memcpy(out, &v, sizeof v); };
   switch (type) {
-    case PrtType::Int8: put(std::int8_t(value)); break;
-    case PrtType::UInt8: put(std::uint8_t(value)); break;
-    case PrtType::Int16: put(std::int16_t(value)); break;
-    case PrtType::UInt16: put(std::uint16_t(value)); break;
-    case PrtType::Int32: put(std::int32_t(value)); break;
-    case PrtType::UInt32: put(std::uint32_t(value)); break;
-    case PrtType::Int64: put(std::int64_t(value)); break;
-    case PrtType::UInt64: put(std::uint64_t(value)); break;
-    case PrtType::Float16: put(floatToHalf(float(value))); break;
-    case PrtType::Float32: put(float(value)); break;
-    case PrtType::Float64: put(value); break;
+    case PrtType::Int8:
+      put(std::int8_t(value));
+      break;
+    case PrtType::UInt8:
+      put(std::uint8_t(value));
+      break;
+    case PrtType::Int16:
+      put(std::int16_t(value));
+      break;
+    case PrtType::UInt16:
+      put(std::uint16_t(value));
+      break;
+    case PrtType::Int32:
+      put(std::int32_t(value));
+      break;
+    case PrtType::UInt32:
+      put(std::uint32_t(value));
+      break;
+    case PrtType::Int64:
+      put(std::int64_t(value));
+      break;
+    case PrtType::UInt64:
+      put(std::uint64_t(value));
+      break;
+    case PrtType::Float16:
+      put(floatToHalf(float(value)));
+      break;
+    case PrtType::Float32:
+      put(float(value));
+      break;
+    case PrtType::Float64:
+      put(value);
+      break;
   }
 }
 
 struct PrtWriteOptions {
-  int version = 2;               ///< 1: PRT 1.0, 2: PRT 1.1 with metadata chunks
-  bool reverseOffsets = false;   ///< lay the channels out in the record in reverse order
+  int version = 2;              ///< 1: PRT 1.0, 2: PRT 1.1 with metadata chunks
+  bool reverseOffsets = false;  ///< lay the channels out in the record in reverse order
   bool unknownCount = false;    ///< write the particle count as -1
-  std::size_t piece = 4096;      ///< bytes of records deflated between flushes
+  std::size_t piece = 4096;     ///< bytes of records deflated between flushes
   int level = 6;
 };
 

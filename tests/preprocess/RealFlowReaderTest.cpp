@@ -164,7 +164,7 @@ TEST(RealFlowReader, TrailingSectionsOfDifferentWriters) {
   EXPECT_EQ(read(9, testing::kRealFlowTail5), 5u);   // Krakatoa
   EXPECT_EQ(read(11, testing::kRealFlowTail6), 5u);  // 6 bytes
   EXPECT_EQ(read(11, testing::kRealFlowTail10), 5u);
-  EXPECT_EQ(read(8, ""), 5u);                        // older versions: no trailing section
+  EXPECT_EQ(read(8, ""), 5u);  // older versions: no trailing section
   expectFileError([&] { read(11, testing::kRealFlowTail5); }, {"t.bin", "RF5 internal data flag"});
   expectFileError([&] { read(9, ""); }, {"t.bin", "additional data count"});
   expectFileError([&] { read(11, testing::kRealFlowTail6 + "x"); }, {"t.bin", "1 bytes of trailing garbage"});

@@ -10,7 +10,9 @@
 namespace flipscope::testing {
 
 /// The float stored in float field `field` (0 position ... ), component c, of particle p.
-inline float realFlowValue(std::size_t p, int field, int c) { return float(p) * 0.5f + float(field) * 100.f + float(c); }
+inline float realFlowValue(std::size_t p, int field, int c) {
+  return float(p) * 0.5f + float(field) * 100.f + float(c);
+}
 
 /// Trailing sections as different writers make them.
 inline const std::string kRealFlowTail10("\0\0\0\0\0\1\0\0\0\0", 10);  // RealFlow itself
@@ -26,13 +28,13 @@ inline std::string makeRealFlowBin(int version, std::size_t count, const std::st
   std::memcpy(name, fluid.data(), fluid.size());
   out.append(name, 250);
   put(std::int16_t(version));
-  put(1.f);                 // scale
-  put(std::int32_t(8));     // fluid type
-  put(0.5f);                // elapsed time
-  put(std::int32_t(12));    // frame
-  put(std::int32_t(24));    // fps
+  put(1.f);               // scale
+  put(std::int32_t(8));   // fluid type
+  put(0.5f);              // elapsed time
+  put(std::int32_t(12));  // frame
+  put(std::int32_t(24));  // fps
   put(std::int32_t(count));
-  put(0.1f);                // radius
+  put(0.1f);                                  // radius
   for (int i = 0; i < 9; ++i) put(float(i));  // pressure, speed, temperature ranges
   if (version >= 7)
     for (int i = 0; i < 9; ++i) put(i >= 6 ? 1.f : 0.f);  // emitter position, rotation, scale
@@ -41,9 +43,9 @@ inline std::string makeRealFlowBin(int version, std::size_t count, const std::st
     auto vec = [&](int f) {
       for (int c = 0; c < 3; ++c) put(realFlowValue(p, f, c));
     };
-    vec(field++);  // position
-    vec(field++);  // velocity
-    vec(field++);  // force
+    vec(field++);                  // position
+    vec(field++);                  // velocity
+    vec(field++);                  // force
     if (version >= 9) vec(field);  // vorticity
     ++field;
     if (version >= 3) vec(field);  // normal
@@ -51,8 +53,8 @@ inline std::string makeRealFlowBin(int version, std::size_t count, const std::st
     if (version >= 4) put(std::int32_t(p % 30));  // neighbours
     ++field;
     if (version >= 5) {
-      vec(field);                     // texture
-      put(std::int16_t(p % 3));       // info bits
+      vec(field);                // texture
+      put(std::int16_t(p % 3));  // info bits
     }
     ++field;
     for (int scalar = 0; scalar < 7; ++scalar) put(realFlowValue(p, field + scalar, 0));  // age ... temperature

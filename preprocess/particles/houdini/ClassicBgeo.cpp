@@ -2,13 +2,13 @@
 // read as particles: the points, with every numeric point attribute. Big-endian throughout;
 // strings are a var16 length (an int16, or -1 and an int32) and their bytes.
 //
-// The points are read in chunks (memory: the chunk, plus at most 16 MiB of records). What
-// follows them is checked once the last point has been read: the vertex and primitive
-// dictionaries, the primitives (particle systems, "Part", are walked and their point indices
-// checked), the detail attributes and the extra section, which ends the file with 00 ff. Where
-// the file holds something this reader cannot walk (other primitive types, groups, unknown
-// attribute types after the points), the rest is taken on trust, except that the file must
-// still end with the end marker 0xff.
+// The points are read in chunks, 1 MiB of records at a time, decoded while they are in cache
+// (memory: the chunk and that 1 MiB). What follows them is checked once the last point has been
+// read: the vertex and primitive dictionaries, the primitives (particle systems, "Part", are
+// walked and their point indices checked), the detail attributes and the extra section, which
+// ends the file with 00 ff. Where the file holds something this reader cannot walk (other
+// primitive types, groups, unknown attribute types after the points), the rest is taken on
+// trust, except that the file must still end with the end marker 0xff.
 #include "preprocess/particles/houdini/ClassicBgeo.h"
 
 #include <algorithm>
@@ -25,12 +25,18 @@ namespace houdini {
 
 std::string classicTypeName(std::int32_t type) {
   switch (type) {
-    case 0: return "float";
-    case 1: return "int";
-    case 2: return "string";
-    case 3: return "mixed";
-    case 4: return "index";
-    case 5: return "vector";
+    case 0:
+      return "float";
+    case 1:
+      return "int";
+    case 2:
+      return "string";
+    case 3:
+      return "mixed";
+    case 4:
+      return "index";
+    case 5:
+      return "vector";
   }
   return std::to_string(type);
 }
@@ -57,7 +63,7 @@ using houdini::ClassicType;
 constexpr char kBinaryMagic[5] = {'B', 'g', 'e', 'o', 'V'};
 constexpr std::int32_t kVersion = 5;
 constexpr std::int32_t kParticlePrimitive = 0x8000;  // "Part"
-constexpr std::size_t kBatchBytes = std::size_t(16) << 20;
+constexpr std::size_t kBatchBytes = std::size_t(1) << 20;
 
 /// Big-endian fields read from an InputFile, with the messages of a classic bgeo.
 class Fields {
@@ -119,16 +125,17 @@ class ClassicBgeoReader final : public ParticleSource {
     Fields in(mFile);
     char magic[5] = {};
     if (mFile.read(magic, 5) != 5 || std::memcmp(magic, kBinaryMagic, 5) != 0)
-      throw FileError(mFile.path(), "bad magic: not a Houdini classic geometry file (expected 'BgeoV' or 'PGEOMETRY V5')");
+      throw FileError(mFile.path(),
+                      "bad magic: not a Houdini classic geometry file (expected 'BgeoV' or 'PGEOMETRY V5')");
     const std::int32_t version = in.int32("the version");
     if (version != kVersion)
       throw FileError(mFile.path(), "classic bgeo version " + std::to_string(version) + " (this reader reads version " +
                                         std::to_string(kVersion) + ")");
-    const char* names[8] = {"NPoints",         "NPrims",        "NPointGroups", "NPrimGroups",
-                            "NPointAttrib",    "NVertexAttrib", "NPrimAttrib",  "NAttrib"};
-    std::int64_t* counts[8] = {&mHeader.points,          &mHeader.primitives,          &mHeader.pointGroups,
-                               &mHeader.primitiveGroups, &mHeader.pointAttributes,     &mHeader.vertexAttributes,
-                               &mHeader.primitiveAttributes, &mHeader.detailAttributes};
+    const char* names[8] = {"NPoints",      "NPrims",        "NPointGroups", "NPrimGroups",
+                            "NPointAttrib", "NVertexAttrib", "NPrimAttrib",  "NAttrib"};
+    std::int64_t* counts[8] = {
+        &mHeader.points,          &mHeader.primitives,       &mHeader.pointGroups,         &mHeader.primitiveGroups,
+        &mHeader.pointAttributes, &mHeader.vertexAttributes, &mHeader.primitiveAttributes, &mHeader.detailAttributes};
     for (int i = 0; i < 8; ++i) {
       const std::uint64_t at = in.offset();
       *counts[i] = in.int32(names[i]);
@@ -221,8 +228,8 @@ class ClassicBgeoReader final : public ParticleSource {
       a.name = in.string("an attribute name");
       a.size = in.uint16("an attribute size");
       const std::int32_t type = in.int32("an attribute type");
-      const std::string where = std::string(kind) + " attribute '" + a.name + "' (definition at byte " +
-                                std::to_string(at) + ")";
+      const std::string where =
+          std::string(kind) + " attribute '" + a.name + "' (definition at byte " + std::to_string(at) + ")";
       if (a.size == 0) throw FileError(mFile.path(), "classic bgeo: " + where + " has size 0");
       switch (type) {
         case std::int32_t(ClassicType::Float):
@@ -274,8 +281,8 @@ class ClassicBgeoReader final : public ParticleSource {
       const std::int32_t vertices = in.int32("a particle primitive's vertex count");
       if (vertices < 0 || std::uint64_t(vertices) > in.left() / vertexBytes)
         throw FileError(mFile.path(), "classic bgeo: particle primitive " + std::to_string(p) + " (at byte " +
-                                          std::to_string(at) + ") has " + std::to_string(vertices) +
-                                          " vertices, but " + std::to_string(in.left()) + " bytes are left");
+                                          std::to_string(at) + ") has " + std::to_string(vertices) + " vertices, but " +
+                                          std::to_string(in.left()) + " bytes are left");
       checkVertexIndices(std::uint64_t(vertices), vertexBytes, p);
       in.skip(primitiveBytes, "primitive attribute values");
     }
@@ -315,9 +322,10 @@ class ClassicBgeoReader final : public ParticleSource {
           index = __builtin_bswap16(narrow);
         }
         if (index >= std::uint64_t(mHeader.points))
-          throw FileError(mFile.path(), "classic bgeo: vertex " + std::to_string(begin + v) + " of particle primitive " +
-                                            std::to_string(primitive) + " refers to point " + std::to_string(index) +
-                                            " of " + std::to_string(mHeader.points));
+          throw FileError(mFile.path(), "classic bgeo: vertex " + std::to_string(begin + v) +
+                                            " of particle primitive " + std::to_string(primitive) +
+                                            " refers to point " + std::to_string(index) + " of " +
+                                            std::to_string(mHeader.points));
       }
     }
   }

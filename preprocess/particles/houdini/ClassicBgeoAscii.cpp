@@ -39,8 +39,7 @@ class ClassicGeoReader final : public ParticleSource {
     std::vector<std::string_view> words;
     if (!nextLine(words) || words.size() != 2 || words[0] != "PGEOMETRY")
       throw FileError(mFile.path(), "bad magic: not a Houdini classic geo file (expected 'PGEOMETRY V5' on line 1)");
-    if (words[1] != "V5")
-      throw fail("version '" + std::string(words[1]) + "' (this reader reads PGEOMETRY V5)");
+    if (words[1] != "V5") throw fail("version '" + std::string(words[1]) + "' (this reader reads PGEOMETRY V5)");
     readCounts(words);
     if (mCounts[4] > 0) {
       if (!nextLine(words)) throw fail("the file ends before the point attributes");
