@@ -254,6 +254,14 @@ TEST(ClassicBgeoReader, TruncatedAtEveryLengthIsRefused) {
   testing::expectEveryTruncationRefused("test.geo", testing::readBytes(kFolder / "test.geo"));
   testing::expectEveryTruncationRefused("w.bgeo", testing::makeClassicBgeo(4, kAttributes, position, value, options));
   testing::expectEveryTruncationRefused("w.geo", testing::makeClassicGeo(4, kAttributes, position, value, options));
+  // No points: the header and what follows it (detail attributes here) are all there is.
+  const testing::BgeoWriteOptions detail{false, true};
+  const std::string none = testing::makeClassicBgeo(0, kAttributes, position, value, detail);
+  EXPECT_EQ(testing::readBytesCompletely("none.bgeo", none), 0u);
+  testing::expectEveryTruncationRefused("none.bgeo", none);
+  const std::string noneGeo = testing::makeClassicGeo(0, kAttributes, position, value, detail);
+  EXPECT_EQ(testing::readBytesCompletely("none.geo", noneGeo), 0u);
+  testing::expectEveryTruncationRefused("none.geo", noneGeo);
 }
 
 TEST(ClassicBgeoReader, SingleByteCorruptionsAreReadOrRefused) {

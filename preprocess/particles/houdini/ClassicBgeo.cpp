@@ -176,7 +176,11 @@ class ClassicBgeoReader final : public ParticleSource {
     const std::uint64_t total = std::uint64_t(mHeader.points);
     const std::size_t n = std::size_t(std::min<std::uint64_t>(maxParticles, total - mNext));
     prepareColumns(chunk, mColumns, n);
-    if (n == 0) return false;
+    if (n == 0) {
+      if (!mTailChecked) checkTail();  // no points: what follows the header is all there is
+      mTailChecked = true;
+      return false;
+    }
     chunk.positions.resize(n);
     if (mHasVelocity) chunk.velocities.resize(n);
     const std::size_t batch = std::max<std::size_t>(1, kBatchBytes / mStride);

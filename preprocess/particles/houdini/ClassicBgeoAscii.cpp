@@ -72,10 +72,14 @@ class ClassicGeoReader final : public ParticleSource {
     chunk.clear();
     const std::size_t n = std::size_t(std::min<std::uint64_t>(maxParticles, mCounts[0] - mNext));
     prepareColumns(chunk, mColumns, n);
-    if (n == 0) return false;
+    std::vector<std::string_view> words;
+    if (n == 0) {
+      if (!mTailChecked) checkTail(words);  // no points: what follows the header is all there is
+      mTailChecked = true;
+      return false;
+    }
     chunk.positions.resize(n);
     if (mHasVelocity) chunk.velocities.resize(n);
-    std::vector<std::string_view> words;
     mRow.resize(mValues);
     for (std::size_t k = 0; k < n; ++k) {
       readPoint(words, mNext + k, chunk.positions[k]);
