@@ -13,11 +13,11 @@
 // (float[3], from 5), info bits (int16, from 5), age, isolation time, viscosity, density,
 // pressure, mass, temperature (float each), id (int32; int64 from version 12).
 //
-// A trailing section follows the particles (from version 9 on): int32 count of additional
-// per-particle data, a byte flag "RF4 internal data", from version 10 a byte flag "RF5 internal
-// data", and when that is set an int32. Writers differ (Krakatoa writes 5 zero bytes, others 6,
-// RealFlow itself 10), so it is checked as far as it is understood and taken on trust beyond
-// (additional data, internal data that is not empty).
+// A trailing section follows the particles (checked from version 9 on): int32 count of
+// additional per-particle data, a byte flag "RF4 internal data", from version 10 a byte flag "RF5
+// internal data", and when that is set an int32. Writers differ (Krakatoa writes 5 zero bytes,
+// others 6, RealFlow itself 10), so it is checked as far as it is understood and taken on trust
+// beyond (additional data, internal data that is not empty).
 //
 // The records are read in chunks, 1 MiB of records at a time, decoded while they are in cache
 // (memory: the chunk and that 1 MiB); the trailing section is checked once the last particle has
@@ -179,12 +179,7 @@ class RealFlowReader final : public ParticleSource {
     mTailChecked = true;
     const std::uint64_t start = mDataOffset + mCount * mStride;
     mFile.seek(start);
-    const std::uint64_t left = mFile.size() - start;
-    if (mVersion < 9 && left == 0) return;
-    auto where = [&](const char* what) {
-      return std::string(what) + " of the trailing section (at byte " + std::to_string(mFile.offset()) +
-             ", after the particles)";
-    };
+    if (mVersion < 9) return;  // what older versions put after the particles is not known here
     const auto additional = field<std::int32_t>("the trailing section's additional data count");
     if (additional < 0)
       throw fail("negative count " + std::to_string(additional) + " of additional particle data at byte " +
@@ -205,8 +200,8 @@ class RealFlowReader final : public ParticleSource {
       if (internal != 0) return;  // internal data: taken on trust
     }
     if (mFile.offset() != mFile.size())
-      throw fail(std::to_string(mFile.size() - mFile.offset()) + " bytes of trailing garbage after the " +
-                 where("end"));
+      throw fail(std::to_string(mFile.size() - mFile.offset()) + " bytes of trailing garbage after the trailing " +
+                 "section, which ends at byte " + std::to_string(mFile.offset()));
   }
 
   InputFile mFile;
