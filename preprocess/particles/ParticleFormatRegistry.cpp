@@ -24,6 +24,12 @@ const std::vector<ParticleFormat>& formatTable() {
       {"bgeo", "Houdini geometry (binary or ASCII JSON)",
        {".bgeo", ".geo", ".bgeo.sc", ".geo.sc", ".bgeo.gz", ".geo.gz"}, detail::isHoudiniJson,
        detail::openHoudiniJson, nullptr},
+      {"bgeo-classic", "Houdini classic geometry (BgeoV / PGEOMETRY)", {".bgeo", ".geo", ".bgeo.gz", ".geo.gz"},
+       detail::isClassicBgeo, detail::openClassicBgeo, nullptr},
+      {"prt", "Krakatoa PRT particles", {".prt"}, detail::isPrt, detail::openPrtParticles, nullptr},
+      // By content only (magic 0xFABADA): a ".bin" name means raw floats, below.
+      {"realflow-bin", "RealFlow particle cache (.bin, recognised by content)", {}, detail::isRealFlowBin,
+       detail::openRealFlowParticles, nullptr},
       // No magic: recognised by name only, so it stays last.
       {"raw", "raw little-endian float32 xyz", {".bin", ".raw"}, nullptr, detail::openRawParticles,
        detail::createRawWriter},
@@ -34,6 +40,7 @@ const std::vector<ParticleFormat>& formatTable() {
 const std::vector<ContainerFormat>& containerTable() {
   static const std::vector<ContainerFormat> table = {
       {"scf1", ".sc", detail::isScf, detail::decodeScf},
+      {"gzip", ".gz", detail::isGzip, detail::decodeGzip},
   };
   return table;
 }

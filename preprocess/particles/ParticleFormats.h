@@ -50,6 +50,23 @@ std::unique_ptr<ParticleSource> openHoudiniJson(InputFile file, const ReadOption
 /// decoded with random access (houdini/ScfContainer.cpp).
 bool isScf(InputFile& file);
 std::unique_ptr<ByteSource> decodeScf(InputFile file);
+/// gzip container around any of them, concatenated members allowed (GzipContainer.cpp).
+bool isGzip(InputFile& file);
+std::unique_ptr<ByteSource> decodeGzip(InputFile file);
+
+/// Houdini classic geometry, version 5: binary "BgeoV" and ASCII "PGEOMETRY"
+/// (houdini/ClassicBgeo.cpp, houdini/ClassicBgeoAscii.cpp).
+bool isClassicBgeo(std::span<const std::byte> head);
+std::unique_ptr<ParticleSource> openClassicBgeo(InputFile file, const ReadOptions& options);
+
+/// Krakatoa PRT 1.0 and 1.1, every channel type (PrtParticles.cpp).
+bool isPrt(std::span<const std::byte> head);
+std::unique_ptr<ParticleSource> openPrtParticles(InputFile file, const ReadOptions& options);
+
+/// RealFlow particle cache .bin, versions 1 to 12 (RealFlowParticles.cpp). By content only:
+/// the name ".bin" means raw floats.
+bool isRealFlowBin(std::span<const std::byte> head);
+std::unique_ptr<ParticleSource> openRealFlowParticles(InputFile file, const ReadOptions& options);
 
 /// Which of `available` ReadOptions asks for, as indices into `available`, in the order asked
 /// (all of them for allAttributes). Throws FileError naming `file`, the missing attribute and

@@ -17,6 +17,10 @@
 #include "TestSupport.h"
 #include "preprocess/particles/ParticleWriter.h"
 #include "preprocess/BgeoTestWriter.h"
+#include "preprocess/ClassicBgeoTestWriter.h"
+#include "preprocess/GzipTestWriter.h"
+#include "preprocess/PrtTestWriter.h"
+#include "preprocess/RealFlowTestWriter.h"
 #include "preprocess/VdbTestFiles.h"
 #include "preprocess/VtkTestWriter.h"
 
@@ -200,6 +204,45 @@ TEST(FuzzCorpus, Write) {
       writeSeed(corpus / "bgeo_sc" / "synthetic_chunks.bgeo.sc", bgeo::scfContainer(binary, 700));
     }
   }
+
+  // Houdini classic geometry, Krakatoa PRT, RealFlow .bin: small real files and the test
+  // writers' files with every feature; gzip: some of each gzipped, one in two members.
+  const fs::path formats = fs::path(FLIPSCOPE_DATA_DIR) / "formats";
+  for (const char* name : {"test.bgeo", "test.geo", "base.bgeo", "scatter.bgeo"})
+    writeSeed(corpus / "classic_bgeo" / name, bytesOf(formats / "houdini-classic" / name));
+  const std::vector<testing::BgeoAttributeSpec> bgeoAttributes = {
+      {"v", 5, 3, {}}, {"id", 1, 1, {}}, {"name", 4, 1, {"a", "b"}}, {"uv", 0, 2, {}}};
+  auto bgeoPosition = [](std::size_t p, int c) { return float(p) * 0.5f + float(c); };
+  auto bgeoValue = [](std::size_t p, std::size_t a, int c) { return double(p % 2) + double(a) + c * 0.25; };
+  const std::string writtenBgeo = testing::makeClassicBgeo(6, bgeoAttributes, bgeoPosition, bgeoValue, {true, true});
+  writeSeed(corpus / "classic_bgeo" / "written.bgeo", writtenBgeo);
+  writeSeed(corpus / "classic_bgeo" / "written.geo",
+            testing::makeClassicGeo(6, bgeoAttributes, bgeoPosition, bgeoValue, {true, true}));
+  writeSeed(corpus / "prt" / "fractal.prt", bytesOf(formats / "krakatoa-prt" / "prt_fractal_for_krscene.prt"));
+  std::vector<testing::PrtChannelSpec> prtChannels = {{"Position", testing::PrtType::Float16, 3},
+                                                      {"Velocity", testing::PrtType::Float64, 3}};
+  for (int type = 0; type <= 10; ++type)
+    prtChannels.push_back({"c" + std::to_string(type), testing::PrtType(type), 1 + type % 4});
+  auto prtValue = [](std::size_t p, std::size_t i, int c) { return double((p + i + std::size_t(c)) % 50); };
+  const std::string typesPrt = testing::makePrt(prtChannels, 12, prtValue, {.piece = 100});
+  writeSeed(corpus / "prt" / "types.prt", typesPrt);
+  writeSeed(corpus / "prt" / "unknown_count.prt",
+            testing::makePrt({{"Position", testing::PrtType::Float32, 3}}, 9, prtValue, {.version = 1, .unknownCount = true}));
+  for (const char* name : {"Circle01_00000.bin", "Circle01_00001.bin"})
+    writeSeed(corpus / "realflow_bin" / name, bytesOf(formats / "realflow-bin" / name));
+  const std::string v12 = testing::makeRealFlowBin(12, 3);
+  writeSeed(corpus / "realflow_bin" / "v12.bin", v12);
+  writeSeed(corpus / "realflow_bin" / "v9.bin", testing::makeRealFlowBin(9, 2, testing::kRealFlowTail5));
+  writeSeed(corpus / "realflow_bin" / "v4.bin", testing::makeRealFlowBin(4, 2, ""));
+  auto text = [](const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  };
+  writeSeed(corpus / "gzip" / "test.bgeo.gz", testing::gzip(text(formats / "houdini-classic" / "test.bgeo")));
+  writeSeed(corpus / "gzip" / "le_v.ply.gz", testing::gzip(text(corpus / "ply" / "le_v.ply"), 2));
+  writeSeed(corpus / "gzip" / "types.prt.gz", testing::gzip(typesPrt));
+  writeSeed(corpus / "gzip" / "v12.bin.gz", testing::gzip(v12));
+  writeSeed(corpus / "gzip" / "written.bgeo.gz.gz", testing::gzip(testing::gzip(writtenBgeo)));
 
   // OpenVDB files: every codec, compression and layout (compact: a few KB each), and Mantaflow.
   // (Not the uncompressed ones: 158 KB of internal node values, and libFuzzer's -max_len follows

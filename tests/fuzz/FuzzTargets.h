@@ -8,6 +8,8 @@
 //   vdb_points, ply, raw    a particle file (read completely, at most kMaxParticles)
 //   vtk, vtu                the same, with every attribute
 //   bgeo, bgeo_sc           a Houdini .bgeo or .geo (by content), and one in the scf1 container
+//   classic_bgeo, prt,      a particle file, read with every attribute: Houdini classic
+//   realflow_bin, gzip      geometry, Krakatoa PRT, RealFlow .bin, and any of them gzipped
 //   store_header            store.fsh (parsed as is, then again with its checksum made right)
 //   frame_index             u32 n, store.fsh (n bytes), then a frame file; the index is read as
 //                           is and again with its checksum made right, then every brick decoded
@@ -51,6 +53,10 @@ struct Target {
 
 inline Result readParticles(const char* name, std::span<const std::byte> input, const ReadOptions& options = {}) {
   try {
+inline Result readParticles(const char* name, std::span<const std::byte> input, bool allAttributes = false) {
+  try {
+    ReadOptions options;
+    options.allAttributes = allAttributes;
     auto source = openParticleBytes(name, input, options);
     (void)source->countHint();
     (void)source->spacingHint();
@@ -61,6 +67,9 @@ inline Result readParticles(const char* name, std::span<const std::byte> input, 
         total += chunk.size();
         if (chunk.velocities.size() != (source->hasVelocity() ? chunk.size() : 0))
           throw LogicError("chunk velocities do not match hasVelocity()");
+        for (const auto& column : chunk.attributes)
+          if (column.values.size() != chunk.size() * std::size_t(column.arity))
+            throw LogicError("attribute column '" + column.name + "' does not match the chunk");
         if (pass == 1 && total > 3000) break;
       }
       source->rewind();
@@ -83,6 +92,10 @@ inline Result vtk(std::span<const std::byte> input) { return readParticles("fuzz
 inline Result vtu(std::span<const std::byte> input) { return readParticles("fuzz.vtu", input, everyAttribute()); }
 inline Result bgeo(std::span<const std::byte> input) { return readParticles("fuzz.bgeo", input, everyAttribute()); }
 inline Result bgeoSc(std::span<const std::byte> input) { return readParticles("fuzz.bgeo.sc", input, everyAttribute()); }
+inline Result classicBgeo(std::span<const std::byte> input) { return readParticles("fuzz.bgeo", input, true); }
+inline Result prt(std::span<const std::byte> input) { return readParticles("fuzz.prt", input, true); }
+inline Result realFlowBin(std::span<const std::byte> input) { return readParticles("fuzz.bin", input, true); }
+inline Result gzip(std::span<const std::byte> input) { return readParticles("fuzz.gz", input, true); }
 
 /// Overwrites the last 8 bytes with the checksum of the bytes before them.
 inline void fixTrailingChecksum(std::vector<std::byte>& bytes) {
@@ -226,6 +239,10 @@ inline constexpr Target kTargets[] = {
     {"vtu", vtu},
     {"bgeo", bgeo},
     {"bgeo_sc", bgeoSc},
+    {"classic_bgeo", classicBgeo},
+    {"prt", prt},
+    {"realflow_bin", realFlowBin},
+    {"gzip", gzip},
     {"store_header", storeHeader},
     {"frame_index", frameIndex},
     {"brick_payload", brickPayload},

@@ -22,8 +22,9 @@ rm -rf "$work"
 mkdir -p "$work"
 summary=""
 failed=""
-for pair in vdb_points:VdbPoints ply:Ply raw:Raw vtk:Vtk vtu:Vtu bgeo:Bgeo bgeo_sc:BgeoSc store_header:StoreHeader frame_index:FrameIndex \
-  brick_payload:BrickPayload camera:Camera; do
+for pair in vdb_points:VdbPoints ply:Ply raw:Raw vtk:Vtk vtu:Vtu bgeo:Bgeo bgeo_sc:BgeoSc classic_bgeo:ClassicBgeo \
+  prt:Prt realflow_bin:RealFlow gzip:Gzip store_header:StoreHeader frame_index:FrameIndex brick_payload:BrickPayload \
+  camera:Camera; do
   name=${pair%%:*}
   binary="$build/tests/fuzz/${pair#*:}Fuzz"
   mkdir -p "$work/$name"

@@ -1,0 +1,41 @@
+// Decoding columns of fixed-size binary records (PRT, RealFlow .bin, classic bgeo): one value
+// type, byte order, offset and stride for a whole column, decoded to float in a tight loop. The
+// switch on the type runs once a column, never once a value. Private to flipscope::particles.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "preprocess/particles/ParticleSource.h"
+
+namespace flipscope::detail {
+
+enum class ByteOrder : std::uint8_t { Little, Big };
+
+/// Bytes of one component of `type` (1, 2, 4 or 8).
+std::size_t valueTypeBytes(ValueType type);
+
+/// IEEE 754 binary16 to float, exactly (subnormals, infinities and NaN included).
+float halfToFloat(std::uint16_t bits);
+
+/// Decodes `count` records: from each, `arity` components of `type` starting at `first` (the
+/// column in the first record), records `stride` bytes apart, into `out` (count * arity floats,
+/// record after record). Integers convert to the nearest float, doubles round to float.
+void decodeColumn(ValueType type, ByteOrder order, const std::byte* first, std::size_t stride, int arity,
+                  std::size_t count, float* out);
+
+/// decodeColumn() with arity 3 into vectors.
+inline void decodeVec3Column(ValueType type, ByteOrder order, const std::byte* first, std::size_t stride,
+                             std::size_t count, glm::vec3* out) {
+  static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
+  decodeColumn(type, order, first, stride, 3, count, reinterpret_cast<float*>(out));
+}
+
+/// Gives `chunk` the columns of `wanted` (names and arities; a chunk may come from another
+/// source) with room for `count` particles each.
+void prepareColumns(ParticleChunk& chunk, const std::vector<AttributeColumn>& wanted, std::size_t count);
+
+}  // namespace flipscope::detail

@@ -1,0 +1,12 @@
+// libFuzzer target: the Houdini classic geometry reader (houdini/ClassicBgeo*.cpp). Input format and body:
+// FuzzTargets.h.
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "FuzzTargets.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  flipscope::fuzz::classicBgeo(std::as_bytes(std::span(data, size)));
+  return 0;
+}

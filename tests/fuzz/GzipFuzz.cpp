@@ -1,0 +1,12 @@
+// libFuzzer target: the gzip container (GzipContainer.cpp) around any particle file. Input format and body:
+// FuzzTargets.h.
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "FuzzTargets.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  flipscope::fuzz::gzip(std::as_bytes(std::span(data, size)));
+  return 0;
+}
