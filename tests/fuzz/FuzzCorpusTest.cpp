@@ -207,7 +207,6 @@ TEST(FuzzCorpus, Write) {
 
   // Houdini classic geometry, Krakatoa PRT, RealFlow .bin: small real files and the test
   // writers' files with every feature; gzip: some of each gzipped, one in two members.
-  const fs::path formats = fs::path(FLIPSCOPE_DATA_DIR) / "formats";
   for (const char* name : {"test.bgeo", "test.geo", "base.bgeo", "scatter.bgeo"})
     writeSeed(corpus / "classic_bgeo" / name, bytesOf(formats / "houdini-classic" / name));
   const std::vector<testing::BgeoAttributeSpec> bgeoAttributes = {

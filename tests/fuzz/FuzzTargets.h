@@ -53,10 +53,6 @@ struct Target {
 
 inline Result readParticles(const char* name, std::span<const std::byte> input, const ReadOptions& options = {}) {
   try {
-inline Result readParticles(const char* name, std::span<const std::byte> input, bool allAttributes = false) {
-  try {
-    ReadOptions options;
-    options.allAttributes = allAttributes;
     auto source = openParticleBytes(name, input, options);
     (void)source->countHint();
     (void)source->spacingHint();
@@ -92,10 +88,10 @@ inline Result vtk(std::span<const std::byte> input) { return readParticles("fuzz
 inline Result vtu(std::span<const std::byte> input) { return readParticles("fuzz.vtu", input, everyAttribute()); }
 inline Result bgeo(std::span<const std::byte> input) { return readParticles("fuzz.bgeo", input, everyAttribute()); }
 inline Result bgeoSc(std::span<const std::byte> input) { return readParticles("fuzz.bgeo.sc", input, everyAttribute()); }
-inline Result classicBgeo(std::span<const std::byte> input) { return readParticles("fuzz.bgeo", input, true); }
-inline Result prt(std::span<const std::byte> input) { return readParticles("fuzz.prt", input, true); }
-inline Result realFlowBin(std::span<const std::byte> input) { return readParticles("fuzz.bin", input, true); }
-inline Result gzip(std::span<const std::byte> input) { return readParticles("fuzz.gz", input, true); }
+inline Result classicBgeo(std::span<const std::byte> input) { return readParticles("fuzz.bgeo", input, everyAttribute()); }
+inline Result prt(std::span<const std::byte> input) { return readParticles("fuzz.prt", input, everyAttribute()); }
+inline Result realFlowBin(std::span<const std::byte> input) { return readParticles("fuzz.bin", input, everyAttribute()); }
+inline Result gzip(std::span<const std::byte> input) { return readParticles("fuzz.gz", input, everyAttribute()); }
 
 /// Overwrites the last 8 bytes with the checksum of the bytes before them.
 inline void fixTrailingChecksum(std::vector<std::byte>& bytes) {
