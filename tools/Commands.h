@@ -27,6 +27,7 @@ class CommandFailed : public std::runtime_error {
 
 void addConvertCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);
+void addInspectCommand(CLI::App& app);
 void addSynthCommand(CLI::App& app);
 void addBenchCommand(CLI::App& app);  // creates `bench` and calls the four below
 void addRenderCommand(CLI::App& app);

@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "flipscope 0.1.0");
   tools::addConvertCommand(app);
   tools::addInfoCommand(app);
+  tools::addInspectCommand(app);
   tools::addSynthCommand(app);
   tools::addBenchCommand(app);
   tools::addRenderCommand(app);
