@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include <glm/geometric.hpp>
@@ -69,6 +70,30 @@ TEST_F(Render, FlipbookAndCameraOptions) {
   CommandRun inline_ = run("render " + path("store") + " -o " + path("cam2.png") +
                            " --size 32x18 --camera 0.5,0.4,3,0.5,0.2,0.5,0,1,0,35");
   EXPECT_EQ(inline_.exitCode, 0) << inline_.output;
+  CommandRun framed = run("render " + path("store") + " -o " + path("framed.png") + " --size 32x18");
+  EXPECT_EQ(framed.exitCode, 0) << framed.output;
+  const auto bytes = [&](const std::string& name) {
+    std::ifstream in(path(name), std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  EXPECT_EQ(bytes("cam.png"), bytes("cam2.png")) << "--camera-file and --camera give the same camera";
+  EXPECT_NE(bytes("cam.png"), bytes("framed.png")) << "the camera options change the view";
+  EXPECT_NE(bytes("seq_0000.png"), bytes("seq_0001.png")) << "a flipbook renders each frame";
+}
+
+// A real Houdini file (464 points of a Houdini 18.5 demo scene, .bgeo.sc) converts and renders
+// with no options.
+TEST_F(Render, AHoudiniFileRendersWithDefaults) {
+  const fs::path houdini =
+      fs::path(FLIPSCOPE_DATA_DIR) / "formats" / "houdini-bgeo-sc" / "delete_small_parts_demoscene.1.bgeo.sc";
+  CommandRun convert = run("convert '" + houdini.string() + "' -o " + path("houdini") + " -q");
+  ASSERT_EQ(convert.exitCode, 0) << convert.output;
+  CommandRun render = run("render " + path("houdini") + " -o " + path("houdini.exr") + " --size 64x36 --device cpu");
+  ASSERT_EQ(render.exitCode, 0) << render.output;
+  const flipscope::RenderImage image = flipscope::readExr(path("houdini.exr")).image;
+  std::size_t covered = 0;
+  for (float depth : image.depth) covered += std::isfinite(depth);
+  EXPECT_GT(covered, 64u * 36u / 20) << "the default camera frames the Houdini points";
 }
 
 TEST_F(Render, SmoothingAndShadingOptionsChangeTheImage) {
