@@ -137,6 +137,18 @@ INSTANTIATE_TEST_SUITE_P(BrickSizes, ConvertOracle,
                          ::testing::Values(Case{32, 0.05, false}, Case{64, 0.02, true}, Case{128, 0.01, true},
                                            Case{32, 0.5, true}));
 
+// The 16-bit attribute code, against values worked out by hand (the oracle above shares the
+// converter's quantizeAttribute, so it cannot catch a rounding or range bug).
+TEST(Convert, AttributeQuantizationByHand) {
+  EXPECT_EQ(detail::quantizeAttribute(0.0f, 0.0f, 1.0f), 0);
+  EXPECT_EQ(detail::quantizeAttribute(1.0f, 0.0f, 1.0f), 65535);
+  EXPECT_EQ(detail::quantizeAttribute(0.5f, 0.0f, 1.0f), 32768);  // 32767.5 rounds away from zero
+  EXPECT_EQ(detail::quantizeAttribute(3.0f, 2.0f, 6.0f), 16384);  // a quarter: 16383.75
+  EXPECT_EQ(detail::quantizeAttribute(-1.0f, 0.0f, 1.0f), 0);     // clamped below
+  EXPECT_EQ(detail::quantizeAttribute(7.0f, 2.0f, 6.0f), 65535);  // clamped above
+  EXPECT_EQ(detail::quantizeAttribute(5.0f, 5.0f, 5.0f), 0);      // an empty range
+}
+
 TEST(Convert, OutOfCoreStoreIsByteIdenticalToInCore) {
   // ~1.5 M particles (18 MB of float32, 30 MB with velocities) against a 4 MiB budget.
   auto positions = testing::randomParticles(1500000, 77, 50.0f);
@@ -242,6 +254,10 @@ TEST(ConvertSpacing, DefaultConvertOfMantaflowMakesOneCellPerParticleSpacing) {
   EXPECT_EQ(h.cellSize, h.particleSpacing);
   auto source = openParticleFile(file);
   EXPECT_EQ(h.particleSpacing, estimateParticleSpacing(*source).spacing);  // the OpenVDB metadata estimate
+  // Mantaflow at resolution 64 seeds FLIP particles about two a cell axis, cells of 0.0625: the
+  // spacing lies between half a cell and a cell, whatever the estimator does.
+  EXPECT_GT(h.particleSpacing, 0.0625 / 2 * 0.9);
+  EXPECT_LT(h.particleSpacing, 0.0625);
   EXPECT_NE(report.cellSizeOrigin.find("particle spacing"), std::string::npos) << report.cellSizeOrigin;
   EXPECT_NE(report.spacingOrigin.find("frame 30: OpenVDB grid 'particles'"), std::string::npos) << report.spacingOrigin;
   EXPECT_TRUE(report.warnings.empty());

@@ -30,7 +30,8 @@ TEST(BenchSurface, JsonHasEveryFilterAndRofBeatsTheUnsmoothedNormals) {
     EXPECT_GT(f["normal_error_deg"].get<double>(), 0.0) << name;
     EXPECT_LT(f["normal_error_deg"].get<double>(), 90.0) << name;
     EXPECT_GE(f["normal_error_p95_deg"].get<double>(), f["normal_error_deg"].get<double>()) << name;
-    EXPECT_GE(f["depth_error_cells"].get<double>(), 0.0) << name;
+    EXPECT_GT(f["depth_error_cells"].get<double>(), 0.0) << name;
+    EXPECT_LT(f["depth_error_cells"].get<double>(), 2.0) << name << ": the surface is within two cells of the analytic one";
     EXPECT_GT(f["pixels"].get<int>(), 0) << name;
     EXPECT_GT(f["cpu"]["smoothing_ms"].get<double>(), 0.0) << name;
     EXPECT_GT(f["cpu"]["normals_ms"].get<double>(), 0.0) << name;

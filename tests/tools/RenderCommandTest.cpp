@@ -19,6 +19,19 @@ namespace fs = std::filesystem;
 using flipscope::testing::CommandRun;
 CommandRun run(const std::string& args) { return flipscope::testing::runFlipscope(args); }
 
+/// Width and height from a PNG's IHDR chunk (bytes 16 to 23, big-endian), {0, 0} if not a PNG.
+std::pair<std::uint32_t, std::uint32_t> pngSize(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  unsigned char header[24] = {};
+  in.read(reinterpret_cast<char*>(header), sizeof header);
+  if (!in || std::string(reinterpret_cast<char*>(header) + 1, 3) != "PNG") return {0, 0};
+  auto be32 = [&](int at) {
+    return std::uint32_t(header[at]) << 24 | std::uint32_t(header[at + 1]) << 16 | std::uint32_t(header[at + 2]) << 8 |
+           header[at + 3];
+  };
+  return {be32(16), be32(20)};
+}
+
 class Render : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -35,10 +48,7 @@ class Render : public ::testing::Test {
 TEST_F(Render, WritesPngAndExrWithDepthAndNormals) {
   CommandRun png = run("render " + path("store") + " -o " + path("a.png") + " --size 64x36 --device cpu");
   ASSERT_EQ(png.exitCode, 0) << png.output;
-  std::ifstream file(path("a.png"), std::ios::binary);
-  char magic[8] = {};
-  file.read(magic, 8);
-  EXPECT_EQ(std::string(magic + 1, 3), "PNG");
+  EXPECT_EQ(pngSize(path("a.png")), std::make_pair(64u, 36u));
 
   CommandRun exr = run("render " + path("store") + " -o " + path("a.exr") + " --size 64x36 --frame 1 --jitter off");
   ASSERT_EQ(exr.exitCode, 0) << exr.output;
@@ -162,7 +172,7 @@ TEST(Demo, RendersAPreviewImage) {
   flipscope::testing::TempDir temp("demo");
   CommandRun demo = run("demo -o " + (temp.path() / "out").string() + " --particles 50k --frames 2 --size 96x54");
   ASSERT_EQ(demo.exitCode, 0) << demo.output;
-  EXPECT_TRUE(fs::exists(temp.path() / "out" / "preview.png"));
+  EXPECT_EQ(pngSize(temp.path() / "out" / "preview.png"), std::make_pair(96u, 54u));
   EXPECT_NE(demo.output.find("preview.png"), std::string::npos) << demo.output;
 }
 
