@@ -5,11 +5,22 @@
 #include <sys/resource.h>
 
 #include <cstdint>
+#include <cstdio>
 
 namespace flipscope {
 
-/// Peak resident set size of this process so far, in bytes (getrusage ru_maxrss).
+/// Peak resident set size of this process image so far, in bytes: VmHWM of /proc/self/status,
+/// which starts afresh at exec (getrusage's ru_maxrss does not: a child spawned by a large
+/// process would report its parent's peak). getrusage where /proc is missing.
 inline std::uint64_t peakResidentBytes() {
+  if (std::FILE* status = std::fopen("/proc/self/status", "r")) {
+    char line[256];
+    unsigned long long kib = 0;
+    bool found = false;
+    while (!found && std::fgets(line, sizeof line, status)) found = std::sscanf(line, "VmHWM: %llu kB", &kib) == 1;
+    std::fclose(status);
+    if (found) return std::uint64_t(kib) * 1024;
+  }
   rusage usage{};
   ::getrusage(RUSAGE_SELF, &usage);
   return std::uint64_t(usage.ru_maxrss) * 1024;

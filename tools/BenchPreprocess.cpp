@@ -2,7 +2,9 @@
 // Without inputs, a synth frame (raw float32) is generated first (not timed). The input is
 // then read sequentially with plain read() calls (the raw-read limit, warm page cache after
 // the first pass), then converted; the table shows both and their ratio beside the paper's
-// 40 M particles/s (Reichl et al. 2014 §3).
+// 40 M particles/s (Reichl et al. 2014 §3). With --format, a readers table follows
+// (tools/BenchFormats.h): each format's read rate beside the raw-float read, and convert's
+// peak RSS per format against --mem.
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
@@ -20,6 +22,7 @@
 #include "preprocess/Convert.h"
 #include "preprocess/particles/ParticleWriter.h"
 #include "preprocess/SynthFluid.h"
+#include "tools/BenchFormats.h"
 #include "tools/JsonOutput.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
@@ -36,6 +39,9 @@ struct BenchPreprocessArgs {
   std::string mem = "4G";
   std::string workDir;
   bool json = false;
+  std::vector<std::string> formats;  ///< the readers table: formats by extension
+  std::string formatParticles = "5M";
+  std::string formatMem = "64M";
 };
 
 double secondsSince(std::chrono::steady_clock::time_point start) {
@@ -78,6 +84,10 @@ void runBenchPreprocess(const BenchPreprocessArgs& a) {
       if (!keep) fs::remove_all(dir, ec);
     }
   } cleanup{work, !a.workDir.empty()};
+
+  FormatBenchOptions formats{a.formats, parseCount("--format-particles", a.formatParticles), a.formatMem, work};
+  nlohmann::json formatResult;
+  if (!formats.formats.empty()) formatResult = benchFormats(formats);
 
   ConvertOptions options;
   options.memoryBudget = parseBytes("--mem", a.mem);
@@ -138,7 +148,8 @@ void runBenchPreprocess(const BenchPreprocessArgs& a) {
                      {"peak_rss_bytes", double(peakResidentBytes())},
                      {"mem_budget_bytes", options.memoryBudget},
                      {"out_of_core", frame.spillBuckets > 0},
-                     {"source", source}};
+                     {"source", source},
+                     {"readers", formatResult}};
     printJson(j);
     return;
   }
@@ -156,6 +167,7 @@ void runBenchPreprocess(const BenchPreprocessArgs& a) {
               Progress::humanCount(double(frame.storeBytes)).c_str(), double(frame.storeBytes) / rawFloatBytes,
               double(frame.storeBytes) / rawFloatBytes <= 0.25 ? "met" : "NOT met");
   std::printf("peak RSS %s bytes with --mem %s\n", Progress::humanCount(double(peakResidentBytes())).c_str(), a.mem.c_str());
+  if (!formats.formats.empty()) printFormatTable(formatResult, formats);
 }
 
 }  // namespace
@@ -170,6 +182,11 @@ void addBenchPreprocessCommand(CLI::App& bench) {
   cmd->add_option("--mem", args->mem, "Memory budget of the conversion")->capture_default_str();
   cmd->add_option("--work-dir", args->workDir, "Keep the generated input and store here (reused next time)");
   cmd->add_flag("--json", args->json, "Machine-readable output");
+  cmd->add_option("--format", args->formats,
+                  "Also time these readers on the same particles, by extension (repeatable): bgeo.sc, bgeo, prt, vtk, "
+                  "ply, vdb, bin; and each format's convert peak RSS against --format-mem");
+  cmd->add_option("--format-particles", args->formatParticles, "Particles of the readers table")->capture_default_str();
+  cmd->add_option("--format-mem", args->formatMem, "--mem of the readers table's converts")->capture_default_str();
   cmd->callback([args] { runBenchPreprocess(*args); });
 }
 
