@@ -1,15 +1,18 @@
 #!/bin/sh
-# Builds everything with AddressSanitizer and UndefinedBehaviorSanitizer (any report aborts the
-# test that caused it) and runs the whole ctest suite under them, GL tests on llvmpipe included.
+# Builds everything with clang, AddressSanitizer and UndefinedBehaviorSanitizer (any report
+# aborts the test that caused it) and runs the whole ctest suite under them, GL tests on
+# llvmpipe included. The same build holds the libFuzzer targets (FLIPSCOPE_FUZZ), so CI builds
+# the sanitized tree once: tests/fuzz/run-fuzz.sh then runs in the same build directory.
 # Leaks inside Mesa and the EGL loader, which are not ours, are suppressed (tests/asan.supp).
-# CI: tests/run-asan.sh [build-dir]   (default build-asan)
+# CI: tests/run-asan.sh [build-dir]   (default build-san)
 set -eu
 root=$(cd "$(dirname "$0")/.." && pwd)
-build=${1:-build-asan}
-cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFLIPSCOPE_SANITIZE="address;undefined" \
-  -DFLIPSCOPE_TEST_TIMEOUT=1200 >/dev/null
-ninja -C "$build" -j2
-ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=0" \
+build=${1:-build-san}
+CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DFLIPSCOPE_SANITIZE="address;undefined" -DFLIPSCOPE_FUZZ=ON -DFLIPSCOPE_BUILD_TESTS=ON \
+  -DFLIPSCOPE_TEST_TIMEOUT=1200 "$@" >/dev/null
+ninja -C "$build" -j"${FLIPSCOPE_JOBS:-2}"
+ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:detect_stack_use_after_return=0" \
 LSAN_OPTIONS="suppressions=$root/tests/asan.supp:print_suppressions=0" \
 UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
   ctest --test-dir "$build" -j2 --output-on-failure

@@ -14,8 +14,12 @@ runs_limit=${3:-}
 limit="-max_total_time=$seconds"
 [ -n "$runs_limit" ] && limit="-runs=$runs_limit -seed=1 -max_total_time=$((seconds * 4))"
 jobs=${FLIPSCOPE_JOBS:-2}
-CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DFLIPSCOPE_FUZZ=ON -DFLIPSCOPE_BUILD_TESTS=OFF -DFLIPSCOPE_SANITIZE="address;undefined" >/dev/null
+# A build directory that tests/run-asan.sh configured (the same clang, sanitizers and fuzz
+# targets, with the tests) is used as it is.
+if [ ! -f "$build/CMakeCache.txt" ]; then
+  CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DFLIPSCOPE_FUZZ=ON -DFLIPSCOPE_BUILD_TESTS=OFF -DFLIPSCOPE_SANITIZE="address;undefined" >/dev/null
+fi
 ninja -C "$build" -j"$jobs" flipscope_fuzzers
 work="$build/fuzz-run"
 rm -rf "$work"
