@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "core/Box.h"
-#include "preprocess/BrickStore.h"
+#include "preprocess/store/BrickStore.h"
 #include "raycast/BrickPool.h"
 #include "raycast/Camera.h"
 #include "raycast/RaycastDevice.h"

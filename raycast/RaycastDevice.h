@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "preprocess/PresenceOctree.h"
+#include "preprocess/store/PresenceOctree.h"
 #include "raycast/BrickPool.h"
 #include "raycast/RaycastTypes.h"
 #include "streaming/ConvertedBrickCache.h"

@@ -18,7 +18,7 @@
 
 #include "core/Error.h"
 #include "preprocess/Convert.h"
-#include "preprocess/ParticleWriter.h"
+#include "preprocess/particles/ParticleWriter.h"
 #include "preprocess/SynthFluid.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"

@@ -15,7 +15,7 @@
 
 #include "core/Error.h"
 #include "preprocess/Convert.h"
-#include "preprocess/ParticleWriter.h"
+#include "preprocess/particles/ParticleWriter.h"
 #include "preprocess/SynthFluid.h"
 #include "raycast/GpuRaycaster.h"
 #include "pipeline/FramePipeline.h"

@@ -51,7 +51,7 @@
 #include "gl/EglContext.h"
 #include "pipeline/FramePipeline.h"
 #include "preprocess/Convert.h"
-#include "preprocess/PointSpanSource.h"
+#include "preprocess/particles/PointSpanSource.h"
 #include "raycast/RaycastTypes.h"
 #include "smoothing/CpuScreenDevice.h"
 #include "smoothing/GpuScreenDevice.h"

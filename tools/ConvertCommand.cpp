@@ -7,7 +7,7 @@
 #include "core/AtomicFile.h"
 #include "core/Error.h"
 #include "preprocess/Convert.h"
-#include "preprocess/InputSequence.h"
+#include "preprocess/particles/InputSequence.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
 

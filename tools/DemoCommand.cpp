@@ -9,7 +9,7 @@
 
 #include "core/Error.h"
 #include "preprocess/Convert.h"
-#include "preprocess/StoreInspection.h"
+#include "preprocess/store/StoreInspection.h"
 #include "preprocess/SynthFluid.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"

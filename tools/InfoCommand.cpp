@@ -10,8 +10,8 @@
 
 #include "core/Error.h"
 #include "core/Progress.h"
-#include "preprocess/BrickStore.h"
-#include "preprocess/StoreInspection.h"
+#include "preprocess/store/BrickStore.h"
+#include "preprocess/store/StoreInspection.h"
 #include "tools/Commands.h"
 
 namespace flipscope::tools {

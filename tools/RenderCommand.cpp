@@ -6,7 +6,7 @@
 #include <tuple>
 
 #include "core/Error.h"
-#include "preprocess/InputSequence.h"
+#include "preprocess/particles/InputSequence.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
 #include "smoothing/SurfaceFilter.h"

@@ -13,8 +13,8 @@
 
 #include "core/Error.h"
 #include "core/Progress.h"
-#include "preprocess/InputSequence.h"
-#include "preprocess/ParticleWriter.h"
+#include "preprocess/particles/InputSequence.h"
+#include "preprocess/particles/ParticleWriter.h"
 #include "preprocess/SynthFluid.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
