@@ -383,17 +383,20 @@ struct StoredAttribute {
   bool operator==(const StoredAttribute&) const = default;
 };
 
-/// What ConvertOptions::attribute asks for, given the inputs (opened with `probe`: headers only).
-/// Throws FileError, naming the first input without it and what that holds, for a missing name.
+/// What ConvertOptions::attribute asks for, given the inputs (opened with `probe`: headers only)
+/// and the attributes each holds. Throws FileError, naming the first input without it and what
+/// that holds, for a missing name.
 StoredAttribute chooseAttribute(const std::optional<std::string>& asked, const std::vector<FrameInput>& inputs,
-                                const ReadOptions& probe, bool allVelocity) {
+                                const std::vector<std::vector<AttributeDesc>>& held, const ReadOptions& probe,
+                                bool allVelocity) {
   if (!asked) return {allVelocity ? AttributeKind::Speed : AttributeKind::None, allVelocity ? "speed" : ""};
   if (*asked == "none") return {};
   if (asked->empty()) throw InputError("--attribute: an attribute name, speed, auto or none, not ''");
   std::optional<int> arity;
   const FrameInput* lacking = nullptr;
-  for (const auto& input : inputs) {
-    const auto attributes = openFrame(input, probe)->attributes();
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const FrameInput& input = inputs[i];
+    const auto& attributes = held[i];
     auto found = std::find_if(attributes.begin(), attributes.end(),
                               [&](const AttributeDesc& a) { return a.name == *asked; });
     if (found == attributes.end()) {
@@ -693,14 +696,17 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
   ReadOptions probe = options.read;
   probe.attributes.clear();
   probe.allAttributes = false;
+  const bool byName = options.attribute && *options.attribute != "none";
   bool allVelocity = true;
   std::uint64_t hinted = 0;
+  std::vector<std::vector<AttributeDesc>> held;  // with a name asked for: what each input holds
   for (const auto& input : inputs) {
     auto source = openFrame(input, probe);
     allVelocity = allVelocity && source->hasVelocity();
     hinted += source->countHint().value_or(0);
+    if (byName) held.push_back(source->attributes());
   }
-  StoredAttribute attribute = chooseAttribute(options.attribute, inputs, probe, allVelocity);
+  StoredAttribute attribute = chooseAttribute(options.attribute, inputs, held, probe, allVelocity);
 
   ConvertReport report;
   const StoreDirectory directory(storeDir);

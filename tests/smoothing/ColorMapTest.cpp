@@ -92,7 +92,7 @@ float maxDifference(const std::vector<glm::vec4>& a, const std::vector<glm::vec4
   return worst;
 }
 
-TEST(ColorByAttribute, ChangesTheShadedSurfaceInEveryModeButNormals) {
+TEST(ShadingColorByAttribute, ChangesTheShadedSurfaceInEveryModeButNormals) {
   CpuScreenDevice device;
   for (ShadingMode mode : {ShadingMode::Liquid, ShadingMode::Spheres, ShadingMode::Attribute, ShadingMode::Normals}) {
     SCOPED_TRACE(int(mode));
@@ -114,7 +114,7 @@ TEST(ColorByAttribute, ChangesTheShadedSurfaceInEveryModeButNormals) {
   }
 }
 
-TEST(ColorByAttribute, TheLitSurfaceIsTheMapsColourTimesTheLight) {
+TEST(ShadingColorByAttribute, TheLitSurfaceIsTheMapsColourTimesTheLight) {
   // In attribute mode the colour is albedo * light + highlight, the light and highlight the same
   // in every column of a row: so columns differ exactly as the colour map's colours, scaled.
   CpuScreenDevice device;
@@ -134,7 +134,7 @@ TEST(ColorByAttribute, TheLitSurfaceIsTheMapsColourTimesTheLight) {
   }
 }
 
-TEST(ColorByAttribute, TheColourRangePlacesTheFramesValuesOnTheMap) {
+TEST(ShadingColorByAttribute, TheColourRangePlacesTheFramesValuesOnTheMap) {
   // The frame's attribute spans 10..20; a range 10..30 puts its top at the middle of the map,
   // so the ramp shows the lower half of the map: column x as the full range's value x / 2.
   CpuScreenDevice device;
