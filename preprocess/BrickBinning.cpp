@@ -33,9 +33,12 @@ KeyGrid::KeyGrid(const StoreHeader& h, std::optional<Box> clipBox)
 
 float attributeValue(const ParticleChunk& chunk, AttributeKind kind, std::size_t i) {
   switch (kind) {
-    case AttributeKind::None: return 0.0f;
-    case AttributeKind::Speed: return glm::length(chunk.velocities[i]);
-    case AttributeKind::Scalar: return chunk.attributes.front().values[i];
+    case AttributeKind::None:
+      return 0.0f;
+    case AttributeKind::Speed:
+      return glm::length(chunk.velocities[i]);
+    case AttributeKind::Scalar:
+      return chunk.attributes.front().values[i];
     case AttributeKind::Magnitude: {
       const AttributeColumn& column = chunk.attributes.front();
       const float* v = column.values.data() + i * std::size_t(column.arity);
@@ -51,9 +54,8 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, AttributeK
   const std::size_t n = chunk.size();
   const bool attribute = kind != AttributeKind::None;
   FLIPSCOPE_CHECK(kind != AttributeKind::Speed || chunk.velocities.size() == n, "speed needs velocities");
-  FLIPSCOPE_CHECK(kind != AttributeKind::Scalar ||
-                      (!chunk.attributes.empty() && chunk.attributes.front().arity == 1 &&
-                       chunk.attributes.front().values.size() == n),
+  FLIPSCOPE_CHECK(kind != AttributeKind::Scalar || (!chunk.attributes.empty() && chunk.attributes.front().arity == 1 &&
+                                                    chunk.attributes.front().values.size() == n),
                   "a scalar attribute needs its column");
   FLIPSCOPE_CHECK(kind != AttributeKind::Magnitude ||
                       (!chunk.attributes.empty() &&

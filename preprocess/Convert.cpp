@@ -201,7 +201,12 @@ class FrameBinner {
  public:
   FrameBinner(const KeyGrid& grid, AttributeKind kind, const MemoryPlan& plan, const ConvertOptions& options,
               std::filesystem::path scratchDir, int frame)
-      : mGrid(grid), mKind(kind), mAttribute(kind != AttributeKind::None), mPlan(plan), mOptions(options), mScratch(std::move(scratchDir)),
+      : mGrid(grid),
+        mKind(kind),
+        mAttribute(kind != AttributeKind::None),
+        mPlan(plan),
+        mOptions(options),
+        mScratch(std::move(scratchDir)),
         mPrefix(std::string(kSpillPrefix) + std::to_string(::getpid()) + "-" + std::to_string(frame)) {}
 
   void add(const ParticleChunk& chunk) {
@@ -397,8 +402,8 @@ StoredAttribute chooseAttribute(const std::optional<std::string>& asked, const s
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     const FrameInput& input = inputs[i];
     const auto& attributes = held[i];
-    auto found = std::find_if(attributes.begin(), attributes.end(),
-                              [&](const AttributeDesc& a) { return a.name == *asked; });
+    auto found =
+        std::find_if(attributes.begin(), attributes.end(), [&](const AttributeDesc& a) { return a.name == *asked; });
     if (found == attributes.end()) {
       lacking = &input;
       break;
@@ -629,8 +634,8 @@ FrameReport convertOneFrame(ParticleSource& source, BrickStore& store, int frame
     if (kind == AttributeKind::Scalar || kind == AttributeKind::Magnitude) {
       // The source must have been opened with ReadOptions::attributes = {the store's attribute}.
       if (chunk.attributes.empty() || chunk.attributes.front().name != header.attributeName)
-        throw FileError(source.name(), "was read without the attribute '" + header.attributeName +
-                                           "' that the store keeps");
+        throw FileError(source.name(),
+                        "was read without the attribute '" + header.attributeName + "' that the store keeps");
       const int arity = chunk.attributes.front().arity;
       if ((kind == AttributeKind::Scalar) != (arity == 1))
         throw FileError(source.name(), "attribute '" + header.attributeName + "' has " + std::to_string(arity) +
@@ -739,13 +744,11 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
       keepHeader = true;
       const StoredAttribute kept{header.attribute, header.attributeName};
       if (options.attribute && attribute != kept)
-        throw InputError(storeDir.string() + ": the store keeps " +
-                         (kept.kind == AttributeKind::None ? std::string("no attribute")
-                                                           : "the attribute '" + kept.name + "'") +
-                         ", not " +
-                         (attribute.kind == AttributeKind::None ? std::string("none")
-                                                                : "'" + attribute.name + "'") +
-                         " (--attribute); convert into a new store to keep another");
+        throw InputError(
+            storeDir.string() + ": the store keeps " +
+            (kept.kind == AttributeKind::None ? std::string("no attribute") : "the attribute '" + kept.name + "'") +
+            ", not " + (attribute.kind == AttributeKind::None ? std::string("none") : "'" + attribute.name + "'") +
+            " (--attribute); convert into a new store to keep another");
       attribute = kept;
       report.cellSizeOrigin = "kept from the existing store";
       report.spacingOrigin = "the existing store";
@@ -801,8 +804,8 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
     progress.setLabel("convert frame " + std::to_string(inputs[i].frame) + " (" + std::to_string(i + 1) + "/" +
                       std::to_string(inputs.size()) + ")");
     auto source = openFrame(inputs[i], reading.read);
-    report.frames.push_back(convertOneFrame(*source, store, inputs[i].frame, reading, &progress,
-                                            frameless ? &*frameless : nullptr));
+    report.frames.push_back(
+        convertOneFrame(*source, store, inputs[i].frame, reading, &progress, frameless ? &*frameless : nullptr));
     frameless.reset();  // kept: the store has a frame
   }
   progress.setLabel("convert");

@@ -7,10 +7,11 @@
 // before smoothing), thickness (FLOAT, liquid along the ray behind the surface, world units),
 // N.X N.Y N.Z (FLOAT, world-space normal, 0 where nothing was hit) and, when the store has a
 // per-particle attribute, a FLOAT channel named after it (speed, pscale, ...: its value at the
-// surface, 0 where nothing was hit; see attributeChannel). The normal is a layer "N" in the OpenEXR "layer.channel" naming: Nuke splits at the
-// first '.', shows layer N with channels X, Y, Z (only R/G/B/A suffixes are renamed to
-// red/green/blue/alpha), and sorts them in x, y, z order; Houdini's EXR reader groups the
-// N.* channels into one vector plane N; OpenImageIO keeps X, Y, Z in that order as spatial data.
+// surface, 0 where nothing was hit; see attributeChannel). The normal is a layer "N" in the
+// OpenEXR "layer.channel" naming: Nuke splits at the first '.', shows layer N with channels X, Y,
+// Z (only R/G/B/A suffixes are renamed to red/green/blue/alpha), and sorts them in x, y, z order;
+// Houdini's EXR reader groups the N.* channels into one vector plane N; OpenImageIO keeps X, Y, Z
+// in that order as spatial data.
 // Upper-case suffixes match the upper-case R, G, B, A, Z of the file itself.
 #pragma once
 

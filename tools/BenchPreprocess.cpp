@@ -18,8 +18,8 @@
 
 #include "core/Error.h"
 #include "preprocess/Convert.h"
-#include "preprocess/particles/ParticleWriter.h"
 #include "preprocess/SynthFluid.h"
+#include "preprocess/particles/ParticleWriter.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
 

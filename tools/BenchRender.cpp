@@ -14,11 +14,11 @@
 #include <nlohmann/json.hpp>
 
 #include "core/Error.h"
-#include "preprocess/Convert.h"
-#include "preprocess/particles/ParticleWriter.h"
-#include "preprocess/SynthFluid.h"
-#include "raycast/GpuRaycaster.h"
 #include "pipeline/FramePipeline.h"
+#include "preprocess/Convert.h"
+#include "preprocess/SynthFluid.h"
+#include "preprocess/particles/ParticleWriter.h"
+#include "raycast/GpuRaycaster.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
 

@@ -102,10 +102,14 @@ DeviceChoice parseDeviceChoice(const std::string& option, const std::string& tex
 
 std::string describeAttribute(const StoreHeader& header) {
   switch (header.attribute) {
-    case AttributeKind::None: return "none";
-    case AttributeKind::Speed: return "speed (the length of the velocity)";
-    case AttributeKind::Scalar: return header.attributeName + " (scalar)";
-    case AttributeKind::Magnitude: return header.attributeName + " (the length of a vector)";
+    case AttributeKind::None:
+      return "none";
+    case AttributeKind::Speed:
+      return "speed (the length of the velocity)";
+    case AttributeKind::Scalar:
+      return header.attributeName + " (scalar)";
+    case AttributeKind::Magnitude:
+      return header.attributeName + " (the length of a vector)";
   }
   return header.attributeName;
 }

@@ -9,8 +9,8 @@
 
 #include "core/Error.h"
 #include "preprocess/Convert.h"
-#include "preprocess/store/StoreInspection.h"
 #include "preprocess/SynthFluid.h"
+#include "preprocess/store/StoreInspection.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
 #include "tools/RenderJob.h"

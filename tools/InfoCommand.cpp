@@ -136,8 +136,7 @@ void runInfo(const InfoArgs& a) {
     else
       std::printf("spacing    particle spacing unknown (cell size %g)\n", h.cellSize);
     if (range)
-      std::printf("attribute  %s, %g to %g over the frames\n\n", describeAttribute(h).c_str(), range->min,
-                  range->max);
+      std::printf("attribute  %s, %g to %g over the frames\n\n", describeAttribute(h).c_str(), range->min, range->max);
     else
       std::printf("attribute  %s\n\n", describeAttribute(h).c_str());
     std::printf("%7s %14s %9s %8s %10s %12s %9s\n", "frame", "particles", "bricks", "fill", "bits/part", "bytes",

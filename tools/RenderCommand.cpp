@@ -9,10 +9,10 @@
 
 #include "core/Error.h"
 #include "preprocess/particles/InputSequence.h"
-#include "tools/CliValues.h"
-#include "tools/Commands.h"
 #include "smoothing/SurfaceFilter.h"
 #include "smoothing/SurfaceShading.h"
+#include "tools/CliValues.h"
+#include "tools/Commands.h"
 #include "tools/RenderJob.h"
 
 namespace flipscope::tools {
@@ -32,7 +32,7 @@ struct RenderArgs {
   std::optional<int> smoothingIterations;
   std::optional<float> smoothingStrength;
   std::string shading = "liquid";
-  std::string colorBy;                  ///< empty: not given
+  std::string colorBy;  ///< empty: not given
   std::optional<std::string> colorMap;
   std::optional<std::string> colorRange;
   std::string environment;
@@ -165,8 +165,8 @@ void addRenderCommand(CLI::App& app) {
                   "attribute: colour by the store's per-particle attribute (the liquid dyed, the spheres' and lit "
                   "surface's albedo), none (default: attribute with --shading attribute, --color-map or "
                   "--color-range)");
-  cmd->add_option("--color-map", args->colorMap, "Colour map for --color-by attribute: " + colorMapNames() +
-                                                     " (default: viridis)");
+  cmd->add_option("--color-map", args->colorMap,
+                  "Colour map for --color-by attribute: " + colorMapNames() + " (default: viridis)");
   cmd->add_option("--color-range", args->colorRange,
                   "A,B: attribute values at the ends of the colour map (default: the store's range)");
   cmd->add_option("--env", args->environment, "Equirectangular EXR environment (default: procedural sky and ground)");

@@ -49,8 +49,9 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
   const StoreHeader& header = store.header();
   const bool hasAttribute = header.attribute != AttributeKind::None;
   if (job.colorByAttribute.value_or(false) && !hasAttribute)
-    throw InputError(job.store + ": the store has no per-particle attribute to colour by (--color-by attribute); "
-                                 "convert with --attribute NAME");
+    throw InputError(job.store +
+                     ": the store has no per-particle attribute to colour by (--color-by attribute); "
+                     "convert with --attribute NAME");
   surface.shading.colorByAttribute =
       job.colorByAttribute.value_or(surface.shading.mode == ShadingMode::Attribute && hasAttribute);
   if (surface.shading.colorByAttribute && !surface.shading.colorRange)

@@ -13,9 +13,9 @@
 
 #include "core/Error.h"
 #include "core/Progress.h"
+#include "preprocess/SynthFluid.h"
 #include "preprocess/particles/InputSequence.h"
 #include "preprocess/particles/ParticleWriter.h"
-#include "preprocess/SynthFluid.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
 

@@ -4,8 +4,8 @@
 //
 // Attributes: every vertex property other than x, y, z is one scalar attribute, named and typed
 // as the header declares it (vx, vy, vz included: PLY has no vector properties, and the reader
-// groups none; the velocity is vx vy vz, and `speed` in convert is its magnitude). Writes float x y z [vx vy vz] in any of the three encodings; the vertex count
-// is a fixed-width field in the header, patched on commit, so writing streams.
+// groups none; the velocity is vx vy vz, and `speed` in convert is its magnitude). Writes float x y z [vx vy vz] in any
+// of the three encodings; the vertex count is a fixed-width field in the header, patched on commit, so writing streams.
 #include <array>
 #include <bit>
 #include <cctype>
@@ -55,14 +55,22 @@ std::optional<PlyType> plyTypeFromName(const std::string& name) {
 
 ValueType valueTypeOf(PlyType type) {
   switch (type) {
-    case PlyType::Int8: return ValueType::Int8;
-    case PlyType::UInt8: return ValueType::UInt8;
-    case PlyType::Int16: return ValueType::Int16;
-    case PlyType::UInt16: return ValueType::UInt16;
-    case PlyType::Int32: return ValueType::Int32;
-    case PlyType::UInt32: return ValueType::UInt32;
-    case PlyType::Float32: return ValueType::Float32;
-    case PlyType::Float64: return ValueType::Float64;
+    case PlyType::Int8:
+      return ValueType::Int8;
+    case PlyType::UInt8:
+      return ValueType::UInt8;
+    case PlyType::Int16:
+      return ValueType::Int16;
+    case PlyType::UInt16:
+      return ValueType::UInt16;
+    case PlyType::Int32:
+      return ValueType::Int32;
+    case PlyType::UInt32:
+      return ValueType::UInt32;
+    case PlyType::Float32:
+      return ValueType::Float32;
+    case PlyType::Float64:
+      return ValueType::Float64;
   }
   return ValueType::Float32;
 }

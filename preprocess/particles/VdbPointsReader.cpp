@@ -227,7 +227,9 @@ struct CodecEntry {
 template <class T, class Elem, class Codec>
 CodecEntry codecEntry(ValueType valueType) {
   static_assert(sizeof(T) % sizeof(Elem) == 0);
-  return {openvdb::typeNameAsString<T>(), Codec::name(), valueType,
+  return {openvdb::typeNameAsString<T>(),
+          Codec::name(),
+          valueType,
           {sizeof(typename Codec::template Storage<T>::Type), int(sizeof(T) / sizeof(Elem)),
            &decodeComponents<T, Elem, Codec>}};
 }
@@ -1035,9 +1037,8 @@ class VdbPointsReader final : public ParticleSource {
         if (first)
           mAttributes = std::move(here);
         else
-          std::erase_if(mAttributes, [&](const AttributeDesc& a) {
-            return std::find(here.begin(), here.end(), a) == here.end();
-          });
+          std::erase_if(mAttributes,
+                        [&](const AttributeDesc& a) { return std::find(here.begin(), here.end(), a) == here.end(); });
         first = false;
       }
   }
@@ -1046,9 +1047,9 @@ class VdbPointsReader final : public ParticleSource {
   void selectColumns() {
     if (!mOptions.allAttributes)
       for (const auto& name : mOptions.attributes)
-        if (auto unknown = mUnknownTypes.find(name); unknown != mUnknownTypes.end() &&
-                                                      std::none_of(mAttributes.begin(), mAttributes.end(),
-                                                                   [&](const AttributeDesc& a) { return a.name == name; }))
+        if (auto unknown = mUnknownTypes.find(name);
+            unknown != mUnknownTypes.end() && std::none_of(mAttributes.begin(), mAttributes.end(),
+                                                           [&](const AttributeDesc& a) { return a.name == name; }))
           throw FileError(mPath, "attribute " + quote(name) + " has the value type " + quote(unknown->second) +
                                      ", which flipscope does not read");
     const std::vector<std::size_t> selected = selectAttributes(mAttributes, mOptions, mPath);
@@ -1095,16 +1096,19 @@ class VdbPointsReader final : public ParticleSource {
       throw FileError(mPath, leafName(g, leaf) + ": " + what +
                                  " is a strided array (several values a point), which flipscope does not read");
     if (!a.uniform() && a.storedValues() != a.size)
-      throw leafError(g, leaf, what + " stores " + std::to_string(a.storedValues()) + " values for " +
-                                   std::to_string(a.size) + " points");
+      throw leafError(
+          g, leaf,
+          what + " stores " + std::to_string(a.storedValues()) + " values for " + std::to_string(a.size) + " points");
     if (a.size != leaf.position.size)
-      throw leafError(g, leaf, what + " has " + std::to_string(a.size) + " values for " +
-                                   std::to_string(leaf.position.size) + " positions");
+      throw leafError(
+          g, leaf,
+          what + " has " + std::to_string(a.size) + " values for " + std::to_string(leaf.position.size) + " positions");
     const std::uint64_t expected = a.storedValues() * codec.bytes;
     const bool exact = a.paged() || a.uniform();  // otherwise it may be blosc-compressed
     if (exact ? a.bytes != expected : a.bytes > expected)
-      throw leafError(g, leaf, what + " holds " + std::to_string(a.bytes) + " bytes for " + std::to_string(expected) +
-                                   " bytes of values");
+      throw leafError(
+          g, leaf,
+          what + " holds " + std::to_string(a.bytes) + " bytes for " + std::to_string(expected) + " bytes of values");
   }
 
   void addSpacingHint(const PointGrid& g) {
@@ -1204,8 +1208,8 @@ class VdbPointsReader final : public ParticleSource {
       const ColumnSource& source = mColumnSources[mGrid][leaf.descriptor][k];
       const ArrayInfo& a = leaf.extras[mColumnSlots[k]];
       const AttributeCodec& codec = *source.codec;
-      const std::byte* data = arrayBytes(g, leaf, a, source.index, codec.bytes, mExtraPages[k],
-                                         "attribute " + quote(mColumns[k].name));
+      const std::byte* data =
+          arrayBytes(g, leaf, a, source.index, codec.bytes, mExtraPages[k], "attribute " + quote(mColumns[k].name));
       const std::size_t values = std::size_t(a.storedValues());
       std::vector<float>& out = mExtraValues[k];
       out.resize(values * std::size_t(codec.arity));
@@ -1331,13 +1335,13 @@ class VdbPointsReader final : public ParticleSource {
     std::size_t index = 0;  ///< attribute index in the descriptor
     const AttributeCodec* codec = nullptr;
   };
-  std::vector<std::string> mExtraNames;                 ///< VdbParser::extraNames
-  std::vector<AttributeDesc> mAttributes;               ///< attributes()
-  std::map<std::string, std::string> mUnknownTypes;     ///< name -> value type flipscope does not know
-  std::vector<AttributeColumn> mColumns;                ///< the columns read, empty
-  std::vector<std::size_t> mColumnSlots;                ///< per column: its slot in Leaf::extras
+  std::vector<std::string> mExtraNames;                                ///< VdbParser::extraNames
+  std::vector<AttributeDesc> mAttributes;                              ///< attributes()
+  std::map<std::string, std::string> mUnknownTypes;                    ///< name -> value type flipscope does not know
+  std::vector<AttributeColumn> mColumns;                               ///< the columns read, empty
+  std::vector<std::size_t> mColumnSlots;                               ///< per column: its slot in Leaf::extras
   std::vector<std::vector<std::vector<ColumnSource>>> mColumnSources;  ///< [grid][descriptor][column]
-  std::vector<std::vector<float>> mExtraValues;         ///< per column: the loaded leaf's values
+  std::vector<std::vector<float>> mExtraValues;                        ///< per column: the loaded leaf's values
   std::vector<CachedPage> mExtraPages;
   std::vector<std::byte> mRaw, mDecoded, mScratch;
 };

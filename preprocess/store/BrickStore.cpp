@@ -134,8 +134,10 @@ const char* attributeKindName(AttributeKind kind) {
   switch (kind) {
     case AttributeKind::None: return "none";
     case AttributeKind::Speed: return "speed";
-    case AttributeKind::Scalar: return "scalar";
-    case AttributeKind::Magnitude: return "magnitude";
+    case AttributeKind::Scalar:
+      return "scalar";
+    case AttributeKind::Magnitude:
+      return "magnitude";
   }
   return "unknown";
 }
@@ -249,7 +251,8 @@ StoreHeader parseStoreHeader(std::span<const std::byte> bytes, const std::filesy
   std::optional<AttributeRange> range;
   if (h.version >= 4) {
     const auto length = r.get<std::uint32_t>("attribute name length");
-    if (length > kMaxAttributeNameBytes) r.fail("attribute name length", "longer than " + std::to_string(kMaxAttributeNameBytes));
+    if (length > kMaxAttributeNameBytes)
+      r.fail("attribute name length", "longer than " + std::to_string(kMaxAttributeNameBytes));
     auto name = r.getBytes(length, "attribute name");
     h.attributeName.assign(reinterpret_cast<const char*>(name.data()), name.size());
     const auto hasRange = r.get<std::uint32_t>("attribute range flag");
@@ -556,9 +559,9 @@ void BrickStore::addFrame(int frame, const FrameStats& stats) {
   FLIPSCOPE_CHECK(frame >= 0 && frame <= kMaxFrame, frame);
   std::lock_guard lock(mShared->mutex);
   mShared->indices.erase(frame);
-  const std::optional<AttributeRange> range =
-      mHeader.attribute != AttributeKind::None && mHeader.version >= 4 ? widened(mShared->range, stats)
-                                                                       : mShared->range;
+  const std::optional<AttributeRange> range = mHeader.attribute != AttributeKind::None && mHeader.version >= 4
+                                                  ? widened(mShared->range, stats)
+                                                  : mShared->range;
   if (mShared->frames.count(frame) && range == mShared->range) return;
   std::set<int> frames = mShared->frames;
   frames.insert(frame);

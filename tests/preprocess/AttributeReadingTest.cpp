@@ -91,10 +91,9 @@ std::string plyFile(const std::string& format, const std::vector<PlyProperty>& p
   return out;
 }
 
-const std::vector<PlyProperty> kPlyProperties{{"float", "x"},       {"float", "y"},  {"float", "z"},
-                                              {"float", "vx"},      {"float", "vy"}, {"float", "vz"},
-                                              {"float", "pscale"},  {"int", "id"},   {"uchar", "flags"},
-                                              {"double", "density"}, {"short", "age"}};
+const std::vector<PlyProperty> kPlyProperties{
+    {"float", "x"},      {"float", "y"}, {"float", "z"},     {"float", "vx"},       {"float", "vy"}, {"float", "vz"},
+    {"float", "pscale"}, {"int", "id"},  {"uchar", "flags"}, {"double", "density"}, {"short", "age"}};
 
 std::vector<std::vector<double>> plyRows(std::size_t count) {
   std::vector<std::vector<double>> rows;
@@ -111,9 +110,9 @@ TEST(PlyAttributes, EveryPropertyButXyzIsAScalarAttribute) {
   const auto path = dir.path() / "a.ply";
   writeBytes(path, plyFile("ascii", kPlyProperties, plyRows(3)));
   auto source = openParticleFile(path);
-  const std::vector<AttributeDesc> expected{{"vx", ValueType::Float32, 1},     {"vy", ValueType::Float32, 1},
-                                            {"vz", ValueType::Float32, 1},     {"pscale", ValueType::Float32, 1},
-                                            {"id", ValueType::Int32, 1},       {"flags", ValueType::UInt8, 1},
+  const std::vector<AttributeDesc> expected{{"vx", ValueType::Float32, 1},      {"vy", ValueType::Float32, 1},
+                                            {"vz", ValueType::Float32, 1},      {"pscale", ValueType::Float32, 1},
+                                            {"id", ValueType::Int32, 1},        {"flags", ValueType::UInt8, 1},
                                             {"density", ValueType::Float64, 1}, {"age", ValueType::Int16, 1}};
   EXPECT_EQ(source->attributes(), expected);
   EXPECT_TRUE(source->hasVelocity());
@@ -215,18 +214,30 @@ std::vector<float> oracleColumn(const fs::path& path, const std::string& gridNam
         }
       }
     };
-    if (type == "float") emit(float{});
-    else if (type == "double") emit(double{});
-    else if (type == "int32") emit(std::int32_t{});
-    else if (type == "int16") emit(std::int16_t{});
-    else if (type == "int8") emit(std::int8_t{});
-    else if (type == "uint8") emit(std::uint8_t{});
-    else if (type == "int64") emit(std::int64_t{});
-    else if (type == "bool") emit(bool{});
-    else if (type == "vec3s") emit(openvdb::Vec3f{});
-    else if (type == "vec3d") emit(openvdb::Vec3d{});
-    else if (type == "vec3i") emit(openvdb::Vec3i{});
-    else ADD_FAILURE() << "oracle: no handle for " << type;
+    if (type == "float")
+      emit(float{});
+    else if (type == "double")
+      emit(double{});
+    else if (type == "int32")
+      emit(std::int32_t{});
+    else if (type == "int16")
+      emit(std::int16_t{});
+    else if (type == "int8")
+      emit(std::int8_t{});
+    else if (type == "uint8")
+      emit(std::uint8_t{});
+    else if (type == "int64")
+      emit(std::int64_t{});
+    else if (type == "bool")
+      emit(bool{});
+    else if (type == "vec3s")
+      emit(openvdb::Vec3f{});
+    else if (type == "vec3d")
+      emit(openvdb::Vec3d{});
+    else if (type == "vec3i")
+      emit(openvdb::Vec3i{});
+    else
+      ADD_FAILURE() << "oracle: no handle for " << type;
   }
   return out;
 }
@@ -288,12 +299,12 @@ openvdb::GridPtrVec attributeGrid(std::size_t count, bool uniformTag) {
   add.template operator()<float, pts::TruncateCodec>("life", [](std::size_t i) { return 1.0f / float(i + 3); });
   add.template operator()<std::int32_t, pts::NullCodec>("id", [](std::size_t i) { return std::int32_t(7 * i) - 50; });
   add.template operator()<std::int32_t, pts::TruncateCodec>("U", [](std::size_t i) { return std::int32_t(i % 3000); });
-  add.template operator()<std::int8_t, pts::NullCodec>("tag", [](std::size_t i) { return std::int8_t(int(i % 200) - 100); });
+  add.template operator()<std::int8_t, pts::NullCodec>("tag",
+                                                       [](std::size_t i) { return std::int8_t(int(i % 200) - 100); });
   add.template operator()<std::uint8_t, pts::NullCodec>("flags", [](std::size_t i) { return std::uint8_t(i * 13); });
   add.template operator()<double, pts::NullCodec>("mass", [](std::size_t i) { return 1.0 + double(i) / 3.0; });
-  add.template operator()<Vec3f, pts::TruncateCodec>("Cd", [](std::size_t i) {
-    return Vec3f(float(i % 7) / 7.f, 0.25f, 1.f / float(i + 1));
-  });
+  add.template operator()<Vec3f, pts::TruncateCodec>(
+      "Cd", [](std::size_t i) { return Vec3f(float(i % 7) / 7.f, 0.25f, 1.f / float(i + 1)); });
   if (uniformTag) pts::appendAttribute<float>(grid->tree(), "uniform", 2.5f);
   pts::appendGroup(grid->tree(), "splash");
   return {grid};
@@ -334,11 +345,10 @@ TEST(VdbAttributes, ListsEveryAttributeButPWithItsType) {
 
 TEST(VdbAttributes, ColumnsEqualOpenVdbUncompressedAndBlosc) {
   TempDir dir("vdb-columns");
-  for (const auto& [name, compression] :
-       std::vector<std::pair<std::string, std::uint32_t>>{{"none.vdb", openvdb::io::COMPRESS_NONE},
-                                                          {"blosc.vdb", openvdb::io::COMPRESS_BLOSC},
-                                                          {"blosc_mask.vdb", openvdb::io::COMPRESS_BLOSC |
-                                                                                 openvdb::io::COMPRESS_ACTIVE_MASK}}) {
+  for (const auto& [name, compression] : std::vector<std::pair<std::string, std::uint32_t>>{
+           {"none.vdb", openvdb::io::COMPRESS_NONE},
+           {"blosc.vdb", openvdb::io::COMPRESS_BLOSC},
+           {"blosc_mask.vdb", openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK}}) {
     const auto path = dir.path() / name;
     testing::vdbfiles::writeFile(path, attributeGrid(3000, true), compression);
     // v, pscale, life, id, U, tag, flags, mass, Cd, uniform; the group is refused.

@@ -23,7 +23,9 @@ using testing::expectFileError;
 using testing::TempDir;
 
 /// Particle i of a frame: the centre of its own cell of a 10x10x10 grid of unit cells.
-glm::vec3 cellCentre(std::size_t i) { return {float(i % 10) + 0.5f, float((i / 10) % 10) + 0.5f, float(i / 100) + 0.5f}; }
+glm::vec3 cellCentre(std::size_t i) {
+  return {float(i % 10) + 0.5f, float((i / 10) % 10) + 0.5f, float(i / 100) + 0.5f};
+}
 
 /// An ascii PLY of `count` particles, one per cell, with velocity (vx vy vz), a float
 /// `temperature` and an int `id`: temperature(i) = base + 0.37 i (some negative), id = 7 i.
@@ -217,7 +219,8 @@ TEST(ConvertAttribute, VersionThreeStoresAreReadAndAppendedToAsVersionThree) {
   fs::create_directories(store);
   {
     const auto bytes = serializeStoreHeader(header);
-    testing::writeBytes(store / kStoreHeaderName, std::string(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+    testing::writeBytes(store / kStoreHeaderName,
+                        std::string(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
   }
   BrickStore v3 = BrickStore::open(store);
   ASSERT_EQ(v3.header().version, 3u);
@@ -260,7 +263,8 @@ TEST(StoreHeaderAttribute, NameAndRangeRoundTripAndAreChecked) {
   const AttributeRange range{-1.5f, 7.25f};
   std::vector<int> backFrames;
   std::optional<AttributeRange> backRange;
-  const StoreHeader back = parseStoreHeader(serializeStoreHeader(h, frames, range), "store.fsh", &backFrames, &backRange);
+  const StoreHeader back =
+      parseStoreHeader(serializeStoreHeader(h, frames, range), "store.fsh", &backFrames, &backRange);
   EXPECT_EQ(back.attribute, AttributeKind::Magnitude);
   EXPECT_EQ(back.attributeName, "Cd");
   EXPECT_EQ(backFrames, frames);

@@ -67,7 +67,8 @@ TEST(ColorMap, TheMapsDifferFromEachOther) {
   for (std::size_t a = 0; a < 4; ++a)
     for (std::size_t b = a + 1; b < 4; ++b) {
       float total = 0;
-      for (int i = 0; i <= 16; ++i) total += distance(colorMapColour(kMaps[a], i / 16.0f), colorMapColour(kMaps[b], i / 16.0f));
+      for (int i = 0; i <= 16; ++i)
+        total += distance(colorMapColour(kMaps[a], i / 16.0f), colorMapColour(kMaps[b], i / 16.0f));
       EXPECT_GT(total / 17.0f, 0.1f) << colorMapName(kMaps[a]) << " vs " << colorMapName(kMaps[b]);
     }
 }
