@@ -74,6 +74,11 @@ FramePipeline::FramePipeline(std::shared_ptr<BrickSource> source, DeviceChoice d
     : mSurface(surface) {
   validate(settings);
   mSurface.smoothing = resolve(surface.smoothing);
+  if (surface.shading.colorByAttribute && source->header().attribute == AttributeKind::None)
+    throw InputError(source->name() +
+                     ": the store has no per-particle attribute to colour by (convert with --attribute)");
+  if (surface.shading.colorRange && !(surface.shading.colorRange->x < surface.shading.colorRange->y))
+    throw InputError("--color-range: A must be less than B");
   const EnvironmentMap map = surface.environment.empty() ? EnvironmentMap{} : loadEnvironmentMap(surface.environment);
   auto raycaster = createRaycastDevice(device, fallbackReason);
   auto* gpu = dynamic_cast<GpuRaycaster*>(raycaster.get());
@@ -154,6 +159,11 @@ FrameOutput FramePipeline::render(int frame, const Camera& camera, int direction
   });
   timed(out.stages.smoothing, [&] { s.filter->apply(device, s.gbuffer, s.smoothed); });
   timed(out.stages.normals, [&] { reconstructNormals(device, s.smoothed, s.normals); });
+  // The attribute values of the G-buffer's 0 and 1: the frame's quantization range.
+  const StoreHeader& header = mRenderer->source().header();
+  const bool attribute = header.attribute != AttributeKind::None;
+  const FrameStats stats = attribute ? mRenderer->source().frame(frame)->stats : FrameStats{};
+  s.shading->setFrameAttributeRange(stats.attributeMin, stats.attributeMax);
   timed(out.stages.shading, [&] { s.shading->shade(device, s.gbuffer, s.normals, s.sphereNormals, s.shaded); });
 
   timed(out.stages.readback, [&] {
@@ -170,12 +180,18 @@ FrameOutput FramePipeline::render(int frame, const Camera& camera, int direction
     image.unsmoothedDepth.resize(n);
     image.thickness.resize(n);
     image.normal.resize(n);
+    if (attribute) {
+      image.attribute.resize(n);
+      image.attributeName = header.attributeName;
+    }
+    const float span = stats.attributeMax - stats.attributeMin;
     for (std::size_t i = 0; i < n; ++i) {
       const bool hit = gbuffer[i].y > 0.5f;
       image.depth[i] = hit ? smoothed[i].x : kInf;
       image.unsmoothedDepth[i] = hit ? gbuffer[i].x : kInf;
       image.thickness[i] = hit ? gbuffer[i].z : 0.0f;
       image.normal[i] = hit ? glm::vec3(normals[i]) : glm::vec3(0);
+      if (attribute) image.attribute[i] = hit ? stats.attributeMin + gbuffer[i].w * span : 0.0f;
     }
   });
   out.stages.total = msSince(start);

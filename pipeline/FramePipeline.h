@@ -53,7 +53,9 @@ struct StageTimes {
 struct FrameOutput {
   int frame = 0;
   /// rgba: the shaded frame (alpha 1, the environment behind the liquid); depth: the smoothed
-  /// surface (+inf on the background); unsmoothedDepth; normal (smoothed); thickness.
+  /// surface (+inf on the background); unsmoothedDepth; normal (smoothed); thickness; attribute
+  /// (when the store has one: the value of the nearest hit cell, the largest of its particles'
+  /// 16-bit values, in the attribute's units; 0 on the background), named after the attribute.
   RenderImage image;
   RenderStats stats;   ///< the ray-caster's
   StageTimes stages;

@@ -31,20 +31,47 @@ KeyGrid::KeyGrid(const StoreHeader& h, std::optional<Box> clipBox)
   FLIPSCOPE_CHECK(cellBits + codeBits + 16 <= 64, "grid too large for 64-bit keys");
 }
 
-KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, bool attribute, KeyBatch& out) {
+float attributeValue(const ParticleChunk& chunk, AttributeKind kind, std::size_t i) {
+  switch (kind) {
+    case AttributeKind::None:
+      return 0.0f;
+    case AttributeKind::Speed:
+      return glm::length(chunk.velocities[i]);
+    case AttributeKind::Scalar:
+      return chunk.attributes.front().values[i];
+    case AttributeKind::Magnitude: {
+      const AttributeColumn& column = chunk.attributes.front();
+      const float* v = column.values.data() + i * std::size_t(column.arity);
+      float sum = 0;
+      for (int c = 0; c < column.arity; ++c) sum += v[c] * v[c];
+      return std::sqrt(sum);
+    }
+  }
+  return 0.0f;
+}
+
+KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, AttributeKind kind, KeyBatch& out) {
   const std::size_t n = chunk.size();
-  FLIPSCOPE_CHECK(!attribute || chunk.velocities.size() == n, "attribute needs velocities");
+  const bool attribute = kind != AttributeKind::None;
+  FLIPSCOPE_CHECK(kind != AttributeKind::Speed || chunk.velocities.size() == n, "speed needs velocities");
+  FLIPSCOPE_CHECK(kind != AttributeKind::Scalar || (!chunk.attributes.empty() && chunk.attributes.front().arity == 1 &&
+                                                    chunk.attributes.front().values.size() == n),
+                  "a scalar attribute needs its column");
+  FLIPSCOPE_CHECK(kind != AttributeKind::Magnitude ||
+                      (!chunk.attributes.empty() &&
+                       chunk.attributes.front().values.size() == n * std::size_t(chunk.attributes.front().arity)),
+                  "a vector attribute needs its column");
   constexpr std::uint64_t kInvalid = ~0ull, kOutside = ~0ull - 1;
   const std::size_t base = out.cellKeys.size();
   out.cellKeys.resize(base + n);
-  if (attribute) out.speeds.resize(base + n);
+  if (attribute) out.values.resize(base + n);
   std::uint64_t* keys = out.cellKeys.data() + base;
-  float* speeds = attribute ? out.speeds.data() + base : nullptr;
+  float* values = attribute ? out.values.data() + base : nullptr;
   const std::uint32_t mask = grid.header.brickSize - 1;
 
   struct Tally {
     std::uint64_t invalid = 0, outside = 0;
-    float speedMin = std::numeric_limits<float>::infinity(), speedMax = -std::numeric_limits<float>::infinity();
+    float valueMin = std::numeric_limits<float>::infinity(), valueMax = -std::numeric_limits<float>::infinity();
   };
   const Tally tally = tbb::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, n, 1 << 14), Tally{},
@@ -70,11 +97,13 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, bool attri
           const std::uint64_t code = mortonEncode3(brick.x, brick.y, brick.z);
           const std::uint64_t inBrick = local.x | (local.y << grid.brickShift) | (local.z << (2 * grid.brickShift));
           keys[i] = (code << grid.cellBits) | inBrick;
-          if (speeds) {
-            const float s = glm::length(chunk.velocities[i]);
-            speeds[i] = std::isfinite(s) ? s : 0.0f;
-            t.speedMin = std::min(t.speedMin, speeds[i]);
-            t.speedMax = std::max(t.speedMax, speeds[i]);
+          if (values) {
+            const float s = attributeValue(chunk, kind, i);
+            values[i] = s;
+            if (std::isfinite(s)) {
+              t.valueMin = std::min(t.valueMin, s);
+              t.valueMax = std::max(t.valueMax, s);
+            }
           }
         }
         return t;
@@ -82,16 +111,17 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, bool attri
       [](Tally a, const Tally& b) {
         a.invalid += b.invalid;
         a.outside += b.outside;
-        a.speedMin = std::min(a.speedMin, b.speedMin);
-        a.speedMax = std::max(a.speedMax, b.speedMax);
+        a.valueMin = std::min(a.valueMin, b.valueMin);
+        a.valueMax = std::max(a.valueMax, b.valueMax);
         return a;
       });
 
   const std::size_t skipped = tally.invalid + tally.outside;
-  KeyTally result{n - skipped, tally.invalid, tally.outside, 0, 0};
-  if (attribute && skipped < n) {
-    result.speedMin = tally.speedMin;
-    result.speedMax = tally.speedMax;
+  KeyTally result{n - skipped, tally.invalid, tally.outside};
+  if (attribute && tally.valueMin <= tally.valueMax) {
+    result.ranged = true;
+    result.valueMin = tally.valueMin;
+    result.valueMax = tally.valueMax;
   }
   if (skipped == 0) return result;
   // Rare: compact in order (keeps the stream deterministic).
@@ -99,18 +129,20 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, bool attri
   for (std::size_t i = 0; i < n; ++i) {
     if (keys[i] == kInvalid || keys[i] == kOutside) continue;
     keys[kept] = keys[i];
-    if (speeds) speeds[kept] = speeds[i];
+    if (values) values[kept] = values[i];
     ++kept;
   }
   out.cellKeys.resize(base + kept);
-  if (attribute) out.speeds.resize(base + kept);
+  if (attribute) out.values.resize(base + kept);
   return result;
 }
 
 std::uint16_t quantizeAttribute(float s, float min, float max) {
-  if (!(max > min)) return 0;
+  if (!(max > min) || std::isnan(s)) return 0;
   const float t = (s - min) / (max - min);
-  return std::uint16_t(std::lround(std::clamp(t, 0.0f, 1.0f) * 65535.0f));
+  if (!(t > 0.0f)) return 0;
+  if (!(t < 1.0f)) return 65535;
+  return std::uint16_t(std::lround(t * 65535.0f));
 }
 
 namespace {

@@ -38,15 +38,15 @@ struct KeyGrid {
 };
 
 using KeyVector = UninitializedVector<std::uint64_t>;
-using SpeedVector = UninitializedVector<float>;
+using ValueVector = UninitializedVector<float>;
 
-/// Keys of particles: cellKeys (48-bit) and, when the store has an attribute, speeds.
+/// Keys of particles: cellKeys (48-bit) and, when the store has an attribute, its values.
 struct KeyBatch {
   KeyVector cellKeys;
-  SpeedVector speeds;
+  ValueVector values;
   void clear() {
     cellKeys.clear();
-    speeds.clear();
+    values.clear();
   }
 };
 
@@ -55,13 +55,20 @@ struct KeyTally {
   std::uint64_t kept = 0;
   std::uint64_t invalid = 0;  ///< NaN/Inf
   std::uint64_t outside = 0;  ///< outside the grid or the clip box
-  float speedMin = 0, speedMax = 0;  ///< over kept particles, when kept > 0 and with attribute
+  /// Over the finite attribute values of kept particles, when `ranged` (some were finite).
+  bool ranged = false;
+  float valueMin = 0, valueMax = 0;
 };
 
-/// Appends the keys of `chunk` to `out` (parallel over the chunk, deterministic order).
-KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, bool attribute, KeyBatch& out);
+/// The attribute value of particle i of `chunk`: |velocity| for Speed, the first column's value
+/// for Scalar, the length of its components for Magnitude.
+float attributeValue(const ParticleChunk& chunk, AttributeKind kind, std::size_t i);
 
-/// Quantizes speed s into [0, 65535] over [min, max].
+/// Appends the keys of `chunk` to `out` (parallel over the chunk, deterministic order), and the
+/// values of attribute `kind` (attributeValue; not None) when it is not None.
+KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, AttributeKind kind, KeyBatch& out);
+
+/// Quantizes value s into [0, 65535] over [min, max] (NaN and -inf: 0, +inf: 65535).
 std::uint16_t quantizeAttribute(float s, float min, float max);
 
 /// One encoded brick, ready for FrameWriter::addBrick.

@@ -63,7 +63,7 @@ void stopPoint(const char* point) {
 /// Memory plan of one conversion, all derived from the budget.
 struct MemoryPlan {
   explicit MemoryPlan(std::uint64_t budget, bool attribute) {
-    const std::uint64_t perParticle = attribute ? 20 : 16;  // key + scratch (+ speed)
+    const std::uint64_t perParticle = attribute ? 20 : 16;  // key + scratch (+ value)
     chunkParticles = std::clamp<std::uint64_t>(budget / 256 / 24, 4096, 1 << 20);
     maxBinParticles = std::max<std::uint64_t>(budget * 6 / 10 / perParticle, 1 << 16);
     maxBucketFiles = std::clamp<std::uint64_t>(budget / 8 / kSpillBufferBytes, 2, 256);
@@ -73,7 +73,7 @@ struct MemoryPlan {
   std::uint64_t maxBucketFiles;   ///< spill files open at once
 };
 
-/// Spill record: 48-bit cell key, then the speed when the store has an attribute.
+/// Spill record: 48-bit cell key, then the attribute value when the store has an attribute.
 std::size_t recordBytes(bool attribute) { return attribute ? 12 : 8; }
 
 /// Bucket files of one partition level: bucket b holds the keys whose digit
@@ -101,14 +101,14 @@ class SpillBuckets {
   SpillBuckets(const SpillBuckets&) = delete;
   SpillBuckets& operator=(const SpillBuckets&) = delete;
 
-  void add(const std::uint64_t* keys, const float* speeds, std::size_t n) {
+  void add(const std::uint64_t* keys, const float* values, std::size_t n) {
     const std::uint64_t mask = (1ull << mBits) - 1;
     for (std::size_t i = 0; i < n; ++i) {
       Bucket& b = mBuckets[(keys[i] >> mShift) & mask];
       auto* p = reinterpret_cast<const std::byte*>(&keys[i]);
       b.buffer.insert(b.buffer.end(), p, p + 8);
       if (mAttribute) {
-        auto* s = reinterpret_cast<const std::byte*>(&speeds[i]);
+        auto* s = reinterpret_cast<const std::byte*>(&values[i]);
         b.buffer.insert(b.buffer.end(), s, s + 4);
       }
       ++b.records;
@@ -130,7 +130,7 @@ class SpillBuckets {
   std::uint32_t shift() const { return mShift; }
 
   /// Streams bucket b (after finish()) in pieces of at most 8192 records:
-  /// fn(const uint64_t* keys, const float* speeds, size_t n); speeds is null without attribute.
+  /// fn(const uint64_t* keys, const float* values, size_t n); values is null without attribute.
   template <class Fn>
   void forEachPiece(std::size_t b, Fn&& fn) const {
     const Bucket& bucket = mBuckets[b];
@@ -141,7 +141,7 @@ class SpillBuckets {
     const std::size_t bytes = recordBytes(mAttribute);
     std::vector<std::byte> buffer(bytes * kPiece);
     std::vector<std::uint64_t> keys(kPiece);
-    std::vector<float> speeds(mAttribute ? kPiece : 0);
+    std::vector<float> values(mAttribute ? kPiece : 0);
     for (std::uint64_t done = 0; done < bucket.records;) {
       const std::size_t n = std::min<std::uint64_t>(kPiece, bucket.records - done);
       if (std::fread(buffer.data(), bytes, n, f) != n) {
@@ -150,22 +150,22 @@ class SpillBuckets {
       }
       for (std::size_t i = 0; i < n; ++i) {
         std::memcpy(&keys[i], buffer.data() + i * bytes, 8);
-        if (mAttribute) std::memcpy(&speeds[i], buffer.data() + i * bytes + 8, 4);
+        if (mAttribute) std::memcpy(&values[i], buffer.data() + i * bytes + 8, 4);
       }
-      fn(keys.data(), mAttribute ? speeds.data() : nullptr, n);
+      fn(keys.data(), mAttribute ? values.data() : nullptr, n);
       done += n;
     }
     std::fclose(f);
   }
 
-  /// Loads bucket b (after finish()) into keys/speeds.
-  void load(std::size_t b, detail::KeyVector& keys, detail::SpeedVector& speeds) const {
+  /// Loads bucket b (after finish()) into keys/values.
+  void load(std::size_t b, detail::KeyVector& keys, detail::ValueVector& values) const {
     keys.clear();
-    speeds.clear();
+    values.clear();
     keys.reserve(mBuckets[b].records);
     forEachPiece(b, [&](const std::uint64_t* k, const float* s, std::size_t n) {
       keys.insert(keys.end(), k, k + n);
-      if (s) speeds.insert(speeds.end(), s, s + n);
+      if (s) values.insert(values.end(), s, s + n);
     });
   }
 
@@ -199,30 +199,35 @@ class SpillBuckets {
 /// Bins one frame's keys: in memory while they fit, spilled to buckets beyond.
 class FrameBinner {
  public:
-  FrameBinner(const KeyGrid& grid, bool attribute, const MemoryPlan& plan, const ConvertOptions& options,
+  FrameBinner(const KeyGrid& grid, AttributeKind kind, const MemoryPlan& plan, const ConvertOptions& options,
               std::filesystem::path scratchDir, int frame)
-      : mGrid(grid), mAttribute(attribute), mPlan(plan), mOptions(options), mScratch(std::move(scratchDir)),
+      : mGrid(grid),
+        mKind(kind),
+        mAttribute(kind != AttributeKind::None),
+        mPlan(plan),
+        mOptions(options),
+        mScratch(std::move(scratchDir)),
         mPrefix(std::string(kSpillPrefix) + std::to_string(::getpid()) + "-" + std::to_string(frame)) {}
 
   void add(const ParticleChunk& chunk) {
     if (mSpill) {
       mBatch.clear();
-      account(detail::computeKeys(chunk, mGrid, mAttribute, mBatch));
-      mSpill->add(mBatch.cellKeys.data(), mBatch.speeds.data(), mBatch.cellKeys.size());
+      account(detail::computeKeys(chunk, mGrid, mKind, mBatch));
+      mSpill->add(mBatch.cellKeys.data(), mBatch.values.data(), mBatch.cellKeys.size());
       return;
     }
     if (mKeys.cellKeys.capacity() == 0) {  // reserve address space once: no reallocation copies
       mKeys.cellKeys.reserve(mPlan.maxBinParticles + mPlan.chunkParticles);
-      if (mAttribute) mKeys.speeds.reserve(mPlan.maxBinParticles + mPlan.chunkParticles);
+      if (mAttribute) mKeys.values.reserve(mPlan.maxBinParticles + mPlan.chunkParticles);
     }
-    account(detail::computeKeys(chunk, mGrid, mAttribute, mKeys));
+    account(detail::computeKeys(chunk, mGrid, mKind, mKeys));
     if (mKeys.cellKeys.size() > mPlan.maxBinParticles) startSpilling();
   }
 
   /// Bins everything added into `writer`; returns the frame's stats.
   FrameStats finish(FrameWriter& writer) {
     if (!mSpill) {
-      binInMemory(mKeys.cellKeys, mKeys.speeds, writer);
+      binInMemory(mKeys.cellKeys, mKeys.values, writer);
     } else {
       mSpill->finish();
       binBuckets(*mSpill, writer);
@@ -235,10 +240,10 @@ class FrameBinner {
   void account(const detail::KeyTally& t) {
     mStats.skippedInvalid += t.invalid;
     mStats.skippedOutside += t.outside;
-    if (!mAttribute || t.kept == 0) return;
-    mStats.attributeMin = mHasSpeed ? std::min(mStats.attributeMin, t.speedMin) : t.speedMin;
-    mStats.attributeMax = mHasSpeed ? std::max(mStats.attributeMax, t.speedMax) : t.speedMax;
-    mHasSpeed = true;
+    if (!t.ranged) return;
+    mStats.attributeMin = mHasRange ? std::min(mStats.attributeMin, t.valueMin) : t.valueMin;
+    mStats.attributeMax = mHasRange ? std::max(mStats.attributeMax, t.valueMax) : t.valueMax;
+    mHasRange = true;
   }
 
   std::uint32_t bucketBitsFor(std::uint32_t availableBits) const {
@@ -250,20 +255,20 @@ class FrameBinner {
   void startSpilling() {
     const std::uint32_t bits = bucketBitsFor(mGrid.codeBits);
     mSpill = std::make_unique<SpillBuckets>(mScratch, mPrefix, mGrid.cellBits + mGrid.codeBits - bits, bits, mAttribute);
-    mSpill->add(mKeys.cellKeys.data(), mKeys.speeds.data(), mKeys.cellKeys.size());
+    mSpill->add(mKeys.cellKeys.data(), mKeys.values.data(), mKeys.cellKeys.size());
     KeyBatch().cellKeys.swap(mKeys.cellKeys);
-    KeyBatch().speeds.swap(mKeys.speeds);
+    KeyBatch().values.swap(mKeys.values);
     mSpillBuckets += std::uint32_t(mSpill->size());
   }
 
   void binBuckets(const SpillBuckets& buckets, FrameWriter& writer) {
     detail::KeyVector keys;
-    detail::SpeedVector speeds;
+    detail::ValueVector values;
     for (std::size_t b = 0; b < buckets.size(); ++b) {
       if (buckets.records(b) == 0) continue;
       if (buckets.records(b) <= mPlan.maxBinParticles) {
-        buckets.load(b, keys, speeds);
-        binInMemory(keys, speeds, writer);
+        buckets.load(b, keys, values);
+        binInMemory(keys, values, writer);
         continue;
       }
       // Skewed data: split this bucket by the next bits of the brick code.
@@ -280,13 +285,13 @@ class FrameBinner {
     }
   }
 
-  void binInMemory(detail::KeyVector& keys, detail::SpeedVector& speeds, FrameWriter& writer) {
+  void binInMemory(detail::KeyVector& keys, detail::ValueVector& values, FrameWriter& writer) {
     const float lo = mStats.attributeMin, hi = mStats.attributeMax;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, keys.size(), 1 << 16), [&](const auto& range) {
       for (std::size_t i = range.begin(); i != range.end(); ++i)
-        keys[i] = (keys[i] << 16) | (mAttribute ? detail::quantizeAttribute(speeds[i], lo, hi) : 0);
+        keys[i] = (keys[i] << 16) | (mAttribute ? detail::quantizeAttribute(values[i], lo, hi) : 0);
     });
-    detail::SpeedVector().swap(speeds);
+    detail::ValueVector().swap(values);
     detail::KeyVector scratch;
     detail::binKeys(keys, scratch, mGrid, mAttribute, mOptions.zstdLevel, [&](detail::EncodedBrick&& brick) {
       writer.addBrick(brick.coord, brick.particles, brick.cells, brick.payload);
@@ -297,13 +302,14 @@ class FrameBinner {
   }
 
   const KeyGrid& mGrid;
+  AttributeKind mKind;
   bool mAttribute;
   MemoryPlan mPlan;
   const ConvertOptions& mOptions;
   std::filesystem::path mScratch;
   std::string mPrefix;
   FrameStats mStats;
-  bool mHasSpeed = false;
+  bool mHasRange = false;
   KeyBatch mKeys;   // in memory, until spilling starts
   KeyBatch mBatch;  // one chunk, once spilling
   std::unique_ptr<SpillBuckets> mSpill;
@@ -375,19 +381,61 @@ SpacingEstimate measureSpacing(const std::vector<FrameInput>& inputs, const Conv
   return estimate;
 }
 
+/// The attribute a convert stores.
+struct StoredAttribute {
+  AttributeKind kind = AttributeKind::None;
+  std::string name;  ///< the input's attribute (Scalar, Magnitude), "speed" (Speed)
+  bool operator==(const StoredAttribute&) const = default;
+};
+
+/// What ConvertOptions::attribute asks for, given the inputs (opened with `probe`: headers only)
+/// and the attributes each holds. Throws FileError, naming the first input without it and what
+/// that holds, for a missing name.
+StoredAttribute chooseAttribute(const std::optional<std::string>& asked, const std::vector<FrameInput>& inputs,
+                                const std::vector<std::vector<AttributeDesc>>& held, const ReadOptions& probe,
+                                bool allVelocity) {
+  if (!asked) return {allVelocity ? AttributeKind::Speed : AttributeKind::None, allVelocity ? "speed" : ""};
+  if (*asked == "none") return {};
+  if (asked->empty()) throw InputError("--attribute: an attribute name, speed, auto or none, not ''");
+  std::optional<int> arity;
+  const FrameInput* lacking = nullptr;
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const FrameInput& input = inputs[i];
+    const auto& attributes = held[i];
+    auto found =
+        std::find_if(attributes.begin(), attributes.end(), [&](const AttributeDesc& a) { return a.name == *asked; });
+    if (found == attributes.end()) {
+      lacking = &input;
+      break;
+    }
+    if (arity && *arity != found->arity)
+      throw FileError(input.files.front(), "attribute '" + *asked + "' has " + std::to_string(found->arity) +
+                                               " components, but " + std::to_string(*arity) +
+                                               " in the frames before; convert them into separate stores");
+    arity = found->arity;
+  }
+  if (!lacking) return {*arity == 1 ? AttributeKind::Scalar : AttributeKind::Magnitude, *asked};
+  if (*asked == "speed" && allVelocity) return {AttributeKind::Speed, "speed"};
+  // The reader says it: the file, the attribute, and what the file holds.
+  ReadOptions ask = probe;
+  ask.attributes = {*asked};
+  openFrame(*lacking, ask);
+  throw FileError(lacking->files.front(), "has no attribute '" + *asked + "'");
+}
+
 /// The header of a new store: the cell size as ConvertOptions documents it.
-StoreHeader chooseHeader(const Box& bounds, const ConvertOptions& options, bool attribute,
+StoreHeader chooseHeader(const Box& bounds, const ConvertOptions& options, const StoredAttribute& attribute,
                          const SpacingEstimate& spacing, ConvertReport& report) {
   ConvertOptions o = options;
   o.particleSpacing = spacing.spacing;
   report.spacingOrigin = spacing.origin;
   if (options.cellSize) {
     report.cellSizeOrigin = "--cell-size";
-    return makeStoreHeader(bounds, o, attribute);
+    return makeStoreHeader(bounds, o, attribute.kind, attribute.name);
   }
   if (options.resolution) {
     report.cellSizeOrigin = std::to_string(*options.resolution) + " cells along the longest axis";
-    return makeStoreHeader(bounds, o, attribute);
+    return makeStoreHeader(bounds, o, attribute.kind, attribute.name);
   }
   const std::string fallback =
       "; using " + std::to_string(kDefaultResolution) + " cells along the longest axis instead";
@@ -398,7 +446,7 @@ StoreHeader chooseHeader(const Box& bounds, const ConvertOptions& options, bool 
     if (cells <= kMaxCellsPerAxis) {
       o.cellSize = spacing.spacing;
       report.cellSizeOrigin = "one cell per particle spacing";
-      return makeStoreHeader(bounds, o, attribute);
+      return makeStoreHeader(bounds, o, attribute.kind, attribute.name);
     }
     report.warnings.push_back("one cell per particle spacing (" + formatNumber(spacing.spacing) +
                               ") would make the domain " + formatNumber(cells) + " cells long, more than " +
@@ -408,7 +456,7 @@ StoreHeader chooseHeader(const Box& bounds, const ConvertOptions& options, bool 
   }
   o.resolution = kDefaultResolution;
   report.cellSizeOrigin = std::to_string(kDefaultResolution) + " cells along the longest axis (default)";
-  return makeStoreHeader(bounds, o, attribute);
+  return makeStoreHeader(bounds, o, attribute.kind, attribute.name);
 }
 
 /// The store directory for the length of a convert: created when missing (and then removed
@@ -521,7 +569,8 @@ StaleFiles removeStaleFiles(const std::filesystem::path& dir, bool temporaries) 
   return removed;
 }
 
-StoreHeader makeStoreHeader(const Box& bounds, const ConvertOptions& options, bool attribute) {
+StoreHeader makeStoreHeader(const Box& bounds, const ConvertOptions& options, AttributeKind attribute,
+                            const std::string& attributeName) {
   if (options.brickSize != 32 && options.brickSize != 64 && options.brickSize != 128)
     throw InputError("brick size must be 32, 64 or 128, not " + std::to_string(options.brickSize));
   if (bounds.isEmpty()) throw InputError("no finite particle positions: cannot derive a domain (give --domain)");
@@ -543,7 +592,17 @@ StoreHeader makeStoreHeader(const Box& bounds, const ConvertOptions& options, bo
   h.brickSize = options.brickSize;
   h.cellSize = cellSize;
   h.origin = bounds.min;
-  h.attribute = attribute ? AttributeKind::Speed : AttributeKind::None;
+  h.attribute = attribute;
+  h.attributeName = attribute == AttributeKind::Speed  ? std::string("speed")
+                    : attribute == AttributeKind::None ? std::string()
+                                                       : attributeName;
+  if ((attribute == AttributeKind::Scalar || attribute == AttributeKind::Magnitude) &&
+      (h.attributeName.empty() || h.attributeName.size() > kMaxAttributeNameBytes))
+    throw InputError("--attribute: an attribute name of 1 to " + std::to_string(kMaxAttributeNameBytes) +
+                     " bytes, not '" + h.attributeName.substr(0, 64) + "'");
+  for (char c : h.attributeName)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+      throw InputError("--attribute: the attribute name has a control character");
   for (int a = 0; a < 3; ++a) {
     const double cells = std::floor(extent[a] / cellSize) + 1;  // the max corner lands in the last cell
     if (cells > kMaxCellsPerAxis)
@@ -561,16 +620,28 @@ FrameReport convertOneFrame(ParticleSource& source, BrickStore& store, int frame
                             Progress* progress, FramelessHeader* frameless) {
   const auto start = std::chrono::steady_clock::now();
   const StoreHeader& header = store.header();
-  const bool attribute = header.attribute != AttributeKind::None;
-  if (attribute && !source.hasVelocity())
+  const AttributeKind kind = header.attribute;
+  const bool attribute = kind != AttributeKind::None;
+  if (kind == AttributeKind::Speed && !source.hasVelocity())
     throw FileError(source.name(), "has no velocities, but the store keeps a speed attribute");
   const KeyGrid grid(header, options.domain);
   const MemoryPlan plan(options.memoryBudget, attribute);
   const std::filesystem::path scratch = options.scratchDir.empty() ? store.directory() : options.scratchDir;
 
-  FrameBinner binner(grid, attribute, plan, options, scratch, frame);
+  FrameBinner binner(grid, kind, plan, options, scratch, frame);
   ParticleChunk chunk;
   while (source.read(chunk, plan.chunkParticles)) {
+    if (kind == AttributeKind::Scalar || kind == AttributeKind::Magnitude) {
+      // The source must have been opened with ReadOptions::attributes = {the store's attribute}.
+      if (chunk.attributes.empty() || chunk.attributes.front().name != header.attributeName)
+        throw FileError(source.name(),
+                        "was read without the attribute '" + header.attributeName + "' that the store keeps");
+      const int arity = chunk.attributes.front().arity;
+      if ((kind == AttributeKind::Scalar) != (arity == 1))
+        throw FileError(source.name(), "attribute '" + header.attributeName + "' has " + std::to_string(arity) +
+                                           " components here, but the store keeps " +
+                                           (kind == AttributeKind::Scalar ? "a scalar" : "the magnitude of a vector"));
+    }
     binner.add(chunk);
     if (progress) progress->advance(chunk.size());
     stopPoint("chunk");
@@ -595,7 +666,7 @@ FrameReport convertOneFrame(ParticleSource& source, BrickStore& store, int frame
     // Listing the frame and keeping its file (and store.fsh) is one step for the signal handler.
     const DeferCleanupSignals commit;
     try {
-      store.addFrame(frame);
+      store.addFrame(frame, report.stats);
     } catch (...) {
       std::error_code ec;
       if (!listed) std::filesystem::remove(store.framePath(frame), ec);
@@ -626,16 +697,21 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
     if (input.frame < 0 || input.frame > kMaxFrame)
       throw InputError("convert: frame " + std::to_string(input.frame) + " is outside the frames a store holds, 0 to " +
                        std::to_string(kMaxFrame));
-  // Open every frame once to learn velocities and counts (headers only).
+  // Open every frame once to learn velocities, attributes and counts (headers only).
+  ReadOptions probe = options.read;
+  probe.attributes.clear();
+  probe.allAttributes = false;
+  const bool byName = options.attribute && *options.attribute != "none";
   bool allVelocity = true;
   std::uint64_t hinted = 0;
+  std::vector<std::vector<AttributeDesc>> held;  // with a name asked for: what each input holds
   for (const auto& input : inputs) {
-    auto source = openFrame(input, options.read);
+    auto source = openFrame(input, probe);
     allVelocity = allVelocity && source->hasVelocity();
     hinted += source->countHint().value_or(0);
+    if (byName) held.push_back(source->attributes());
   }
-  const bool wantAttribute = options.attribute.value_or(allVelocity);
-  if (wantAttribute && !allVelocity) throw InputError("--attribute speed needs velocities in every input file");
+  StoredAttribute attribute = chooseAttribute(options.attribute, inputs, held, probe, allVelocity);
 
   ConvertReport report;
   const StoreDirectory directory(storeDir);
@@ -666,6 +742,14 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
     if (!existing.incomplete()) {
       header = existing.header();
       keepHeader = true;
+      const StoredAttribute kept{header.attribute, header.attributeName};
+      if (options.attribute && attribute != kept)
+        throw InputError(
+            storeDir.string() + ": the store keeps " +
+            (kept.kind == AttributeKind::None ? std::string("no attribute") : "the attribute '" + kept.name + "'") +
+            ", not " + (attribute.kind == AttributeKind::None ? std::string("none") : "'" + attribute.name + "'") +
+            " (--attribute); convert into a new store to keep another");
+      attribute = kept;
       report.cellSizeOrigin = "kept from the existing store";
       report.spacingOrigin = "the existing store";
     } else {
@@ -673,6 +757,12 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
                                 ": the store has no frames (an interrupted or failed convert); starting it anew");
     }
   }
+  // What every later pass reads: the stored attribute's column, velocities only for speed.
+  ConvertOptions reading = options;
+  reading.read = probe;
+  reading.read.velocity = probe.velocity && attribute.kind == AttributeKind::Speed;
+  if (attribute.kind == AttributeKind::Scalar || attribute.kind == AttributeKind::Magnitude)
+    reading.read.attributes = {attribute.name};
   if (!keepHeader) {
     SpacingEstimate spacing;
     if (options.particleSpacing) {
@@ -681,7 +771,7 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
       if (!(std::isfinite(spacing.spacing) && spacing.spacing >= 0))
         throw InputError("particle spacing must be a positive number or 0");
     } else {
-      spacing = measureSpacing(inputs, options);
+      spacing = measureSpacing(inputs, reading);
     }
     Box bounds;
     if (options.domain) {
@@ -690,14 +780,14 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
       Progress progress("scan bounds", hinted, "particles", options.progress);
       const MemoryPlan plan(options.memoryBudget, false);
       for (const auto& input : inputs)
-        bounds.extend(scanBounds(*openFrame(input, options.read), plan.chunkParticles, &progress));
+        bounds.extend(scanBounds(*openFrame(input, reading.read), plan.chunkParticles, &progress));
       progress.finish();
       if (bounds.isEmpty())
         throw InputError(inputFileNames(inputs) +
                          ": no finite particle positions (no particles, or only NaN/Inf ones): cannot derive a "
                          "domain (give --domain)");
     }
-    header = chooseHeader(bounds, options, wantAttribute, spacing, report);
+    header = chooseHeader(bounds, options, attribute, spacing, report);
   }
   std::optional<FramelessHeader> frameless;
   std::optional<BrickStore> created;
@@ -713,9 +803,9 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     progress.setLabel("convert frame " + std::to_string(inputs[i].frame) + " (" + std::to_string(i + 1) + "/" +
                       std::to_string(inputs.size()) + ")");
-    auto source = openFrame(inputs[i], options.read);
-    report.frames.push_back(convertOneFrame(*source, store, inputs[i].frame, options, &progress,
-                                            frameless ? &*frameless : nullptr));
+    auto source = openFrame(inputs[i], reading.read);
+    report.frames.push_back(
+        convertOneFrame(*source, store, inputs[i].frame, reading, &progress, frameless ? &*frameless : nullptr));
     frameless.reset();  // kept: the store has a frame
   }
   progress.setLabel("convert");

@@ -3,8 +3,9 @@
 //
 // Per frame, particles are quantized to cells of `cellSize` (world units), binned into bricks
 // of brickSize^3 cells, and each brick's particles are stored contiguously (cells and counts,
-// plus an optional 16-bit speed attribute), zstd-compressed one brick at a time; a presence
-// octree over the non-empty bricks closes the frame (PresenceOctree.h).
+// plus an optional 16-bit attribute: the speed, or any attribute of the input files),
+// zstd-compressed one brick at a time; a presence octree over the non-empty bricks closes the
+// frame (PresenceOctree.h).
 //
 // Out of core: memory stays within `memoryBudget` (plus a small constant) whatever the input
 // size. Keys that do not fit are spilled to bucket files by Morton range of their brick and
@@ -69,7 +70,12 @@ struct ConvertOptions {
   std::optional<double> particleSpacing;
   std::uint32_t brickSize = 64;        ///< 32, 64 or 128
   std::uint64_t memoryBudget = kDefaultMemoryBudget;  ///< bytes
-  std::optional<bool> attribute;       ///< store speed; default: when every input has velocities
+  /// The per-particle attribute to store (16 bits, quantized over each frame's [min, max]): unset
+  /// (`auto`): speed when every input has velocities, else none; "none"; or a name: the inputs'
+  /// attribute of that name (a scalar one as it is, a vector one by its length), else, for
+  /// "speed", the length of the velocity. A name an input lacks is a FileError naming the file
+  /// and what it holds. Appending keeps the store's attribute; another one asked for is refused.
+  std::optional<std::string> attribute;
   int zstdLevel = 1;
   std::filesystem::path scratchDir;    ///< spill files; default: the store directory
   ReadOptions read;
@@ -105,7 +111,10 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
 /// cell size options.cellSize, else longest axis / options.resolution (default
 /// kDefaultResolution). Throws InputError when the grid would exceed kMaxCellsPerAxis cells or
 /// the cell size is not positive.
-StoreHeader makeStoreHeader(const Box& bounds, const ConvertOptions& options, bool attribute);
+/// `attribute` and `attributeName` become the header's (the name is "speed" for Speed, empty for
+/// None).
+StoreHeader makeStoreHeader(const Box& bounds, const ConvertOptions& options,
+                            AttributeKind attribute = AttributeKind::None, const std::string& attributeName = "");
 
 /// What removeStaleFiles() removed.
 struct StaleFiles {

@@ -40,6 +40,16 @@ void checkImage(const RenderImage& image) {
                   "unsmoothedDepth=" << image.unsmoothedDepth.size() << " pixels=" << n);
   FLIPSCOPE_CHECK(image.thickness.empty() || image.thickness.size() == n,
                   "thickness=" << image.thickness.size() << " pixels=" << n);
+  FLIPSCOPE_CHECK(image.attribute.empty() || image.attribute.size() == n,
+                  "attribute=" << image.attribute.size() << " pixels=" << n);
+}
+
+/// Every channel writeExr writes besides an attribute's.
+bool isImageChannel(const std::string& name) {
+  for (const char* channel : {"R", "G", "B", "A", "Z", kUnsmoothedDepthChannel, kThicknessChannel, kNormalChannels[0],
+                              kNormalChannels[1], kNormalChannels[2]})
+    if (name == channel) return true;
+  return false;
 }
 
 /// Runs `work` and turns any failure into an `Error` (OutputError for writes, FileError for
@@ -108,6 +118,10 @@ std::string lowerExtension(const std::filesystem::path& path) {
 
 }  // namespace
 
+std::string attributeChannel(const std::string& attributeName) {
+  return attributeName.empty() || isImageChannel(attributeName) ? "attribute." + attributeName : attributeName;
+}
+
 void writeExr(const std::filesystem::path& path, const RenderImage& image) {
   checkImage(image);
   const std::size_t n = pixelCount(image);
@@ -134,6 +148,8 @@ void writeExr(const std::filesystem::path& path, const RenderImage& image) {
   insertFloat("Z", image.depth);
   insertFloat(kUnsmoothedDepthChannel, image.unsmoothedDepth);
   insertFloat(kThicknessChannel, image.thickness);
+  const std::string attribute = attributeChannel(image.attributeName);
+  insertFloat(attribute.c_str(), image.attribute);
   if (!image.normal.empty()) {
     char* base = reinterpret_cast<char*>(const_cast<glm::vec3*>(image.normal.data()));
     for (int c = 0; c < 3; ++c) {
@@ -236,6 +252,12 @@ ExrContents readExr(const std::filesystem::path& path) {
       image.normal.assign(n, glm::vec3(0.0f));
       for (int c = 0; c < 3; ++c)
         frame.insert(kNormalChannels[c], Imf::Slice::Make(Imf::FLOAT, &image.normal[0][c], window, sizeof(glm::vec3)));
+    }
+    for (const std::string& name : contents.channels) {
+      if (isImageChannel(name)) continue;
+      std::vector<float>& values = contents.others[name];
+      values.assign(n, 0.0f);
+      frame.insert(name, Imf::Slice::Make(Imf::FLOAT, values.data(), window, sizeof(float)));
     }
     exr.setFrameBuffer(frame);
     exr.readPixels(window.min.y, window.max.y);

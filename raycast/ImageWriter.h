@@ -4,16 +4,20 @@
 //
 // EXR channels: R G B A (HALF, linear, premultiplied), Z (FLOAT, camera depth in world units,
 // +inf where nothing was hit; the smoothed surface's), unsmoothed.Z (FLOAT, the sphere depth
-// before smoothing), thickness (FLOAT, liquid along the ray behind the surface, world units) and
-// N.X N.Y N.Z (FLOAT, world-space normal, 0 where nothing was hit). The normal is a layer "N" in the OpenEXR "layer.channel" naming: Nuke splits at the
-// first '.', shows layer N with channels X, Y, Z (only R/G/B/A suffixes are renamed to
-// red/green/blue/alpha), and sorts them in x, y, z order; Houdini's EXR reader groups the
-// N.* channels into one vector plane N; OpenImageIO keeps X, Y, Z in that order as spatial data.
+// before smoothing), thickness (FLOAT, liquid along the ray behind the surface, world units),
+// N.X N.Y N.Z (FLOAT, world-space normal, 0 where nothing was hit) and, when the store has a
+// per-particle attribute, a FLOAT channel named after it (speed, pscale, ...: its value at the
+// surface, 0 where nothing was hit; see attributeChannel). The normal is a layer "N" in the
+// OpenEXR "layer.channel" naming: Nuke splits at the first '.', shows layer N with channels X, Y,
+// Z (only R/G/B/A suffixes are renamed to red/green/blue/alpha), and sorts them in x, y, z order;
+// Houdini's EXR reader groups the N.* channels into one vector plane N; OpenImageIO keeps X, Y, Z
+// in that order as spatial data.
 // Upper-case suffixes match the upper-case R, G, B, A, Z of the file itself.
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -30,10 +34,18 @@ struct RenderImage {
   std::vector<glm::vec3> normal;  ///< world-space unit normal, 0 where nothing was hit; empty or width * height
   std::vector<float> unsmoothedDepth;  ///< like depth, before smoothing; empty or width * height
   std::vector<float> thickness;        ///< world units, 0 where nothing was hit; empty or width * height
+  /// The per-particle attribute of the store at each pixel (its units, 0 where nothing was hit),
+  /// empty or width * height, in the EXR channel attributeChannel(attributeName).
+  std::vector<float> attribute;
+  std::string attributeName;
 };
 
-/// Writes R G B A (HALF), Z, unsmoothed.Z, thickness and N.X N.Y N.Z (FLOAT; each only when its
-/// vector is not empty),
+/// The EXR channel of an attribute: its name, or "attribute.<name>" when the name is one of the
+/// channels writeExr writes anyway (R, G, B, A, Z, unsmoothed.Z, thickness, N.X, N.Y, N.Z) or empty.
+std::string attributeChannel(const std::string& attributeName);
+
+/// Writes R G B A (HALF), Z, unsmoothed.Z, thickness, N.X N.Y N.Z and the attribute (FLOAT; each
+/// only when its vector is not empty),
 /// ZIP compressed. Throws FileError naming `path`.
 void writeExr(const std::filesystem::path& path, const RenderImage& image);
 
@@ -50,10 +62,12 @@ void writeImage(const std::filesystem::path& path, const RenderImage& image);
 
 /// What readExr found: every channel name of the file (in the file's, alphabetical, order) and
 /// the image. Missing R, G, B read as 0 and a missing A as 1; depth and normal stay empty
-/// unless the file has Z, or N.X, N.Y and N.Z; unsmoothedDepth and thickness likewise.
+/// unless the file has Z, or N.X, N.Y and N.Z; unsmoothedDepth and thickness likewise. Every
+/// other channel (an attribute's) is read as FLOAT into `others`, by name.
 struct ExrContents {
   std::vector<std::string> channels;
   RenderImage image;
+  std::map<std::string, std::vector<float>> others;
 };
 
 /// Reads an EXR written by writeExr (or any scan-line or tiled single-part EXR with those

@@ -10,9 +10,13 @@
 namespace flipscope {
 
 namespace glsl {
+#include "smoothing/glsl/ColorMap.glsl"
 #include "smoothing/glsl/ShadingTypes.glsl"
-static_assert(sizeof(ShadingParams) == 7 * 16 && offsetof(ShadingParams, mode) == 80 &&
-              offsetof(ShadingParams, fresnelF0) == 96 && offsetof(ShadingParams, shininess) == 108);
+static_assert(sizeof(ShadingParams) == 7 * 16 && offsetof(ShadingParams, mode) == 64 &&
+              offsetof(ShadingParams, colorMap) == 76 && offsetof(ShadingParams, fresnelF0) == 80 &&
+              offsetof(ShadingParams, shininess) == 92 && offsetof(ShadingParams, colorBy) == 96 &&
+              offsetof(ShadingParams, attributeOffset) == 108);
+static_assert(kColorMapCount == 4u && kColorMapBlues == std::uint32_t(ColorMap::Blues));
 
 struct ShadingKernel : CpuScreenKernel {
   ShadingParams S;
@@ -33,11 +37,38 @@ ShadingMode parseShadingMode(const std::string& text) {
   throw InputError("--shading: unknown mode '" + text + "'; valid values: liquid, spheres, attribute, normals");
 }
 
+namespace {
+constexpr const char* kColorMapNames[] = {"viridis", "magma", "coolwarm", "blues"};
+}
+
+ColorMap parseColorMap(const std::string& text) {
+  for (std::uint32_t i = 0; i < glsl::kColorMapCount; ++i)
+    if (text == kColorMapNames[i]) return ColorMap(i);
+  throw InputError("--color-map: unknown colour map '" + text + "'; valid values: " + colorMapNames());
+}
+
+const char* colorMapName(ColorMap map) {
+  return std::uint32_t(map) < glsl::kColorMapCount ? kColorMapNames[std::uint32_t(map)] : "unknown";
+}
+
+std::string colorMapNames() {
+  std::string names;
+  for (const char* name : kColorMapNames) names += (names.empty() ? "" : ", ") + std::string(name);
+  return names;
+}
+
+glm::vec3 colorMapColour(ColorMap map, float t) { return glsl::colorMap(std::uint32_t(map), t); }
+
 SurfaceShading::SurfaceShading(ScreenDevice& device, const ShadingOptions& options, const EnvironmentMap& map)
     : mOptions(options), mMapWidth(map.width), mMapHeight(map.height) {
   FLIPSCOPE_CHECK(map.texels.size() == std::size_t(map.width) * map.height);
   mEnvironment = device.createFixedImage(std::max<std::size_t>(map.texels.size(), 1));
   if (!map.texels.empty()) device.upload(mEnvironment, map.texels);
+}
+
+void SurfaceShading::setFrameAttributeRange(float min, float max) {
+  mFrameMin = min;
+  mFrameMax = max;
 }
 
 void SurfaceShading::shade(ScreenDevice& device, ScreenImage gbuffer, ScreenImage normals, ScreenImage sphereNormals,
@@ -50,8 +81,18 @@ void SurfaceShading::shade(ScreenDevice& device, ScreenImage gbuffer, ScreenImag
   p.lightDirection = glm::vec4(light, 1.0f);
   p.absorption = glm::vec4(mOptions.absorption, 0);
   p.liquidColour = glm::vec4(mOptions.liquidColour, 0);
-  p.slowColour = glm::vec4(mOptions.slowColour, 0);
-  p.fastColour = glm::vec4(mOptions.fastColour, 0);
+  p.albedo = glm::vec4(mOptions.albedo, 0);
+  p.colorBy = mOptions.colorByAttribute ? 1u : 0u;
+  p.colorMap = std::uint32_t(mOptions.colorMap);
+  // t = (value - A) / (B - A), value = frameMin + w (frameMax - frameMin).
+  p.attributeScale = 1.0f;
+  p.attributeOffset = 0.0f;
+  if (mOptions.colorRange) {
+    const float a = mOptions.colorRange->x, b = mOptions.colorRange->y;
+    FLIPSCOPE_CHECK(b > a, a << " " << b);
+    p.attributeScale = (mFrameMax - mFrameMin) / (b - a);
+    p.attributeOffset = (mFrameMin - a) / (b - a);
+  }
   switch (mOptions.mode) {
     case ShadingMode::Liquid: p.mode = glsl::kShadeLiquid; break;
     case ShadingMode::Spheres: p.mode = glsl::kShadeSpheres; break;

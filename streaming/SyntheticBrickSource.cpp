@@ -20,6 +20,7 @@ SyntheticBrickSource::SyntheticBrickSource(std::uint32_t brickSize, glm::uvec3 g
   mHeader.brickGrid = grid;
   mHeader.origin = glm::dvec3(-0.5 * grid.x * brickSize * kCellSize, -0.5 * grid.y * brickSize * kCellSize, 0.0);
   mHeader.attribute = AttributeKind::Speed;
+  mHeader.attributeName = "speed";
   mHeader.particleSpacing = 0;
 }
 

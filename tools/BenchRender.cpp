@@ -107,7 +107,8 @@ void runBenchRender(const BenchRenderArgs& a) {
   options.domain = fluid.domain();
   options.progress = Progress::Mode::Silent;
   {
-    BrickStore store = BrickStore::createOrAppend(storeDir, makeStoreHeader(*options.domain, options, true));
+    BrickStore store =
+        BrickStore::createOrAppend(storeDir, makeStoreHeader(*options.domain, options, AttributeKind::Speed));
     convertFrame(fluid, store, 0, options);
   }
 

@@ -352,7 +352,7 @@ void runBenchSurface(const BenchSurfaceArgs& a) {
     options.particleSpacing = kCellSize;  // one particle per cell^2 of surface: one cell apart
     options.progress = Progress::Mode::Silent;
     fs::remove_all(storeDir);
-    BrickStore store = BrickStore::createOrAppend(storeDir, makeStoreHeader(*options.domain, options, false));
+    BrickStore store = BrickStore::createOrAppend(storeDir, makeStoreHeader(*options.domain, options));
     const std::vector<glm::vec3> points = scene.sample(20140609);
     PointSpanSource source(points, "bench surface scene");
     convertFrame(source, store, 0, options);

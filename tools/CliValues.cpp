@@ -109,4 +109,18 @@ DeviceChoice parseDeviceChoice(const std::string& option, const std::string& tex
   bad(option, text, "auto, gpu or cpu");
 }
 
+std::string describeAttribute(const StoreHeader& header) {
+  switch (header.attribute) {
+    case AttributeKind::None:
+      return "none";
+    case AttributeKind::Speed:
+      return "speed (the length of the velocity)";
+    case AttributeKind::Scalar:
+      return header.attributeName + " (scalar)";
+    case AttributeKind::Magnitude:
+      return header.attributeName + " (the length of a vector)";
+  }
+  return header.attributeName;
+}
+
 }  // namespace flipscope::tools

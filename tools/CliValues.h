@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "core/Box.h"
+#include "preprocess/store/BrickStore.h"
 #include "raycast/GpuRaycaster.h"
 
 namespace flipscope::tools {
@@ -21,5 +22,7 @@ Box parseBox(const std::string& option, const std::string& text);
 std::pair<std::uint32_t, std::uint32_t> parseImageSize(const std::string& option, const std::string& text);
 /// "auto", "gpu" or "cpu" (the `--device` of render, demo and bench render).
 DeviceChoice parseDeviceChoice(const std::string& option, const std::string& text);
+/// "none", "speed (the length of the velocity)", "pscale (scalar)", "v (the length of a vector)".
+std::string describeAttribute(const StoreHeader& header);
 
 }  // namespace flipscope::tools

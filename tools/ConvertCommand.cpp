@@ -40,14 +40,10 @@ void runConvert(const ConvertArgs& a) {
   options.brickSize = a.brickSize;
   if (!a.domain.empty()) options.domain = parseBox("--domain", a.domain);
   options.memoryBudget = parseBytes("--mem", a.mem);
-  if (a.attribute == "speed")
-    options.attribute = true;
-  else if (a.attribute == "none")
-    options.attribute = false;
+  if (a.attribute != "auto") options.attribute = a.attribute;
   options.zstdLevel = a.zstdLevel;
   options.scratchDir = a.scratch;
   options.read.grids = a.grids;
-  options.read.velocity = a.attribute != "none";
   options.progress = a.quiet ? Progress::Mode::Silent : Progress::Mode::Auto;
 
   std::optional<FrameRange> range;
@@ -60,7 +56,7 @@ void runConvert(const ConvertArgs& a) {
   const StoreHeader& h = report.header;
   std::printf("store %s: cell size %g (%s), bricks of %u^3, grid %ux%ux%u bricks, attribute %s\n", a.store.c_str(),
               h.cellSize, report.cellSizeOrigin.c_str(), h.brickSize, h.brickGrid.x, h.brickGrid.y, h.brickGrid.z,
-              attributeName(h.attribute));
+              describeAttribute(h).c_str());
   if (h.particleSpacing > 0)
     std::printf("particle spacing %g (%.2f cells), from %s\n", h.particleSpacing, h.particleSpacing / h.cellSize,
                 report.spacingOrigin.c_str());
@@ -70,6 +66,8 @@ void runConvert(const ConvertArgs& a) {
     std::printf("  frame %d: %llu particles, %u bricks, %s bytes, %.2f s%s", f.frame,
                 (unsigned long long)f.stats.particles, f.bricks, Progress::humanCount(double(f.storeBytes)).c_str(),
                 f.seconds, f.spillBuckets ? " (out of core)" : "");
+    if (h.attribute != AttributeKind::None && f.stats.particles > 0)
+      std::printf("; %s %g to %g", h.attributeName.c_str(), f.stats.attributeMin, f.stats.attributeMax);
     if (f.stats.skippedInvalid || f.stats.skippedOutside)
       std::printf("; skipped %llu NaN/Inf and %llu outside the domain", (unsigned long long)f.stats.skippedInvalid,
                   (unsigned long long)f.stats.skippedOutside);
@@ -102,8 +100,9 @@ void addConvertCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--domain", args->domain, "x0,y0,z0,x1,y1,z1 in world units (default: bounds of the data)");
   cmd->add_option("--mem", args->mem, "Memory budget, e.g. 512M, 8G")->capture_default_str();
-  cmd->add_option("--attribute", args->attribute, "Per-particle attribute to store")
-      ->check(CLI::IsMember({"auto", "speed", "none"}))
+  cmd->add_option("--attribute", args->attribute,
+                  "Per-particle attribute to store (16 bits): auto (speed when the inputs have velocities), none, "
+                  "speed, or the name of an attribute of the inputs (a vector one by its length)")
       ->capture_default_str();
   cmd->add_option("--zstd-level", args->zstdLevel, "zstd level of brick payloads")
       ->check(CLI::Range(-5, 19))

@@ -41,7 +41,7 @@ void runDemo(const DemoArgs& a) {
   options.cellSize = first.cellSize();
   options.domain = first.domain();
   options.particleSpacing = first.cellSize() / 2;  // the body lattice (SynthFluid.h)
-  StoreHeader header = makeStoreHeader(*options.domain, options, true);
+  StoreHeader header = makeStoreHeader(*options.domain, options, AttributeKind::Speed);
   BrickStore store = BrickStore::createOrAppend(storeDir, header);
   std::printf("demo: %d synth frames of %s particles (FLIP-like wave, sheets, spray) -> %s\n", a.frames,
               Progress::humanCount(double(first.count())).c_str(), storeDir.c_str());

@@ -13,6 +13,7 @@
 #include "preprocess/store/BrickStore.h"
 #include "preprocess/store/StoreInspection.h"
 #include "tools/JsonOutput.h"
+#include "tools/CliValues.h"
 #include "tools/Commands.h"
 
 namespace flipscope::tools {
@@ -67,6 +68,21 @@ void runInfo(const InfoArgs& a) {
     total.skippedInvalid += s.skippedInvalid;
     total.skippedOutside += s.skippedOutside;
   }
+  // The attribute's range over the frames (store.fsh records it since version 4).
+  std::optional<AttributeRange> range;
+  if (a.verify) {
+    try {
+      range = store.attributeRange();
+    } catch (const FileError&) {  // a damaged frame of a version 3 store: reported above
+    }
+  } else {
+    range = store.attributeRange();
+  }
+  const bool attribute = h.attribute != AttributeKind::None;
+  auto frameRange = [&](const FrameSummary& s) {
+    return attribute && s.particles > 0 ? nlohmann::json::array({s.attributeMin, s.attributeMax})
+                                        : nlohmann::json(nullptr);
+  };
   const double cells = double(total.bricks) * h.cellsPerBrick();
   const double bpp = total.particles ? cells / double(total.particles) : 0;
   const double ratio = total.storeBytes ? 12.0 * double(total.particles) / double(total.storeBytes) : 0;
@@ -82,7 +98,9 @@ void runInfo(const InfoArgs& a) {
     j["particle_spacing_cells"] = h.particleSpacing > 0 ? nlohmann::json(spacingInCells(h)) : nlohmann::json(nullptr);
     j["origin"] = {h.origin.x, h.origin.y, h.origin.z};
     j["brick_grid"] = {h.brickGrid.x, h.brickGrid.y, h.brickGrid.z};
-    j["attribute"] = attributeName(h.attribute);
+    j["attribute"] = attribute ? h.attributeName : "none";
+    j["attribute_kind"] = attributeKindName(h.attribute);
+    j["attribute_range"] = range ? nlohmann::json::array({range->min, range->max}) : nlohmann::json(nullptr);
     j["store_id"] = storeIdText(h.id);
     j["frames_missing"] = missing;
     j["frames"] = nlohmann::json::array();
@@ -96,7 +114,8 @@ void runInfo(const InfoArgs& a) {
                              {"store_bytes", s.storeBytes},
                              {"ratio_to_raw", s.ratioToRaw},
                              {"skipped_invalid", s.skippedInvalid},
-                             {"skipped_outside", s.skippedOutside}});
+                             {"skipped_outside", s.skippedOutside},
+                             {"attribute_range", frameRange(s)}});
     }
     j["total"] = {{"particles", total.particles},
                   {"bricks", total.bricks},
@@ -117,7 +136,10 @@ void runInfo(const InfoArgs& a) {
                   h.cellSize);
     else
       std::printf("spacing    particle spacing unknown (cell size %g)\n", h.cellSize);
-    std::printf("attribute  %s\n\n", attributeName(h.attribute));
+    if (range)
+      std::printf("attribute  %s, %g to %g over the frames\n\n", describeAttribute(h).c_str(), range->min, range->max);
+    else
+      std::printf("attribute  %s\n\n", describeAttribute(h).c_str());
     std::printf("%7s %14s %9s %8s %10s %12s %9s\n", "frame", "particles", "bricks", "fill", "bits/part", "bytes",
                 "raw/store");
     for (const auto& s : frames)

@@ -3,7 +3,9 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <memory>
+#include <stdexcept>
 #include <tuple>
 
 #include "core/Error.h"
@@ -31,6 +33,9 @@ struct RenderArgs {
   std::optional<int> smoothingIterations;
   std::optional<float> smoothingStrength;
   std::string shading = "liquid";
+  std::string colorBy;  ///< empty: not given
+  std::optional<std::string> colorMap;
+  std::optional<std::string> colorRange;
   std::string environment;
   std::string jitter = "on";
   std::string gpuMem = "1G";
@@ -50,6 +55,30 @@ float parseJitter(const std::string& text) {
   } catch (const std::exception&) {
   }
   throw InputError("--jitter: expected on, off or a number of cells, got '" + text + "'");
+}
+
+/// "A,B" with A < B, both finite.
+glm::vec2 parseColorRange(const std::string& text) {
+  const auto fail = [&](const std::string& why) {
+    return InputError("--color-range: " + why + ", got '" + text + "'; valid values: A,B with A < B (e.g. 0,2.5)");
+  };
+  const std::size_t comma = text.find(',');
+  if (comma == std::string::npos || text.find(',', comma + 1) != std::string::npos)
+    throw fail("expected two numbers A,B");
+  float values[2];
+  const std::string parts[2] = {text.substr(0, comma), text.substr(comma + 1)};
+  for (int i = 0; i < 2; ++i) {
+    try {
+      std::size_t used = 0;
+      values[i] = std::stof(parts[i], &used);
+      if (used != parts[i].size()) throw fail("'" + parts[i] + "' is not a number");
+    } catch (const std::logic_error&) {
+      throw fail("'" + parts[i] + "' is not a number");
+    }
+    if (!std::isfinite(values[i])) throw fail("'" + parts[i] + "' is not finite");
+  }
+  if (!(values[0] < values[1])) throw fail("A must be less than B");
+  return {values[0], values[1]};
 }
 
 glm::dvec3 parseUp(const std::string& text) {
@@ -84,6 +113,16 @@ void runRender(const RenderArgs& a) {
     throw InputError("--smoothing-strength: must be 0 or more, got " + std::to_string(*a.smoothingStrength));
   job.surface.smoothing = resolve(job.surface.smoothing);
   job.surface.shading.mode = parseShadingMode(a.shading);
+  if (a.colorMap) job.surface.shading.colorMap = parseColorMap(*a.colorMap);
+  if (a.colorRange) job.surface.shading.colorRange = parseColorRange(*a.colorRange);
+  if (a.colorBy == "attribute")
+    job.colorByAttribute = true;
+  else if (a.colorBy == "none")
+    job.colorByAttribute = false;
+  else if (!a.colorBy.empty())
+    throw InputError("--color-by: unknown value '" + a.colorBy + "'; valid values: attribute, none");
+  else if (a.colorMap || a.colorRange)
+    job.colorByAttribute = true;  // a colour map or range asks for colour
   job.surface.environment = a.environment;
   job.settings.jitter = parseJitter(a.jitter);
   job.settings.gpuBudgetBytes = parseBytes("--gpu-mem", a.gpuMem);
@@ -127,8 +166,17 @@ void addRenderCommand(CLI::App& app) {
                   "Filter iterations (default: the filter's; see README, Smoothing)");
   cmd->add_option("--smoothing-strength", args->smoothingStrength,
                   "Filter strength: lambda0 in particle radii for rof, the filter's size for the others");
-  cmd->add_option("--shading", args->shading, "liquid, spheres (lit spheres), attribute (colour by attribute) or normals")
+  cmd->add_option("--shading", args->shading,
+                  "liquid, spheres (lit spheres), attribute (the lit surface, coloured by the attribute) or normals")
       ->capture_default_str();
+  cmd->add_option("--color-by", args->colorBy,
+                  "attribute: colour by the store's per-particle attribute (the liquid dyed, the spheres' and lit "
+                  "surface's albedo), none (default: attribute with --shading attribute, --color-map or "
+                  "--color-range)");
+  cmd->add_option("--color-map", args->colorMap,
+                  "Colour map for --color-by attribute: " + colorMapNames() + " (default: viridis)");
+  cmd->add_option("--color-range", args->colorRange,
+                  "A,B: attribute values at the ends of the colour map (default: the store's range)");
   cmd->add_option("--env", args->environment, "Equirectangular EXR environment (default: procedural sky and ground)");
   cmd->add_option("--jitter", args->jitter, "Per-cell jitter: on (0.25 cells), off, or cells")->capture_default_str();
   cmd->add_option("--gpu-mem", args->gpuMem, "Brick pool budget on the device")->capture_default_str();

@@ -46,6 +46,17 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
   settings.radius = job.radius.value_or(defaultSphereRadius(store.header(), settings.jitter));
   SurfaceSettings surface = job.surface;
   surface.up = job.up;
+  const StoreHeader& header = store.header();
+  const bool hasAttribute = header.attribute != AttributeKind::None;
+  if (job.colorByAttribute.value_or(false) && !hasAttribute)
+    throw InputError(job.store +
+                     ": the store has no per-particle attribute to colour by (--color-by attribute); "
+                     "convert with --attribute NAME");
+  surface.shading.colorByAttribute =
+      job.colorByAttribute.value_or(surface.shading.mode == ShadingMode::Attribute && hasAttribute);
+  if (surface.shading.colorByAttribute && !surface.shading.colorRange)
+    if (const auto range = store.attributeRange(); range && range->max > range->min)
+      surface.shading.colorRange = glm::vec2(range->min, range->max);
   std::string fallback;
   FramePipeline pipeline(store, job.device, settings, surface, &fallback);
   FrameRenderer& renderer = pipeline.renderer();
@@ -58,6 +69,14 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
                 : store.header().particleSpacing > 0 ? " (1.5 particle spacings of the store)"
                                                      : " (the store records no particle spacing)",
                 smoothing.name.c_str(), smoothing.iterations, smoothing.strength);
+    if (surface.shading.colorByAttribute) {
+      const char* map = colorMapName(surface.shading.colorMap);
+      if (surface.shading.colorRange)
+        std::printf("render: colour by %s through %s, %g to %g\n", header.attributeName.c_str(), map,
+                    surface.shading.colorRange->x, surface.shading.colorRange->y);
+      else
+        std::printf("render: colour by %s through %s, over each frame's range\n", header.attributeName.c_str(), map);
+    }
   }
 
   Camera camera;

@@ -21,6 +21,10 @@ struct RenderJob {
   RenderSettings settings;       ///< settings.radius is replaced by `radius`
   std::optional<float> radius;   ///< sphere radius in cells; default: defaultSphereRadius(store)
   SurfaceSettings surface;       ///< smoothing and shading; surface.up is set from `up`
+  /// Colour by the store's attribute (--color-by; surface.shading.colorByAttribute is set from
+  /// it). Unset: when the shading mode is `attribute` and the store has one. When set, an unset
+  /// surface.shading.colorRange becomes the store's attribute range.
+  std::optional<bool> colorByAttribute;
   std::optional<Camera> camera;  ///< default: framed on the frames' bricks
   glm::dvec3 up{0, 1, 0};        ///< up axis of the default camera
   DeviceChoice device = DeviceChoice::Auto;

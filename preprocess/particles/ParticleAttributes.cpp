@@ -51,4 +51,13 @@ std::vector<AttributeColumn> detail::makeColumns(const std::vector<AttributeDesc
   return columns;
 }
 
+void detail::syncColumns(std::vector<AttributeColumn>& columns, const std::vector<AttributeColumn>& expected) {
+  columns.resize(expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    if (columns[i].name != expected[i].name) columns[i].name = expected[i].name;
+    columns[i].arity = expected[i].arity;
+    columns[i].values.clear();
+  }
+}
+
 }  // namespace flipscope

@@ -76,5 +76,8 @@ std::vector<std::size_t> selectAttributes(const std::vector<AttributeDesc>& avai
 /// Columns named and sized for `selected` attributes of `available` (values left empty).
 std::vector<AttributeColumn> makeColumns(const std::vector<AttributeDesc>& available,
                                          const std::vector<std::size_t>& selected);
+/// Gives a chunk's `columns` the names and arities of `expected` (the reader's makeColumns),
+/// keeping their storage: a chunk may come from another source or be new.
+void syncColumns(std::vector<AttributeColumn>& columns, const std::vector<AttributeColumn>& expected);
 
 }  // namespace flipscope::detail

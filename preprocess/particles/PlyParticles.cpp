@@ -1,8 +1,11 @@
 // PLY particle files (Turk 1994, "The PLY Polygon File Format"): the vertex element's x y z and,
 // when present, vx vy vz. Reads ascii, binary_little_endian and binary_big_endian with any
-// scalar property type; other vertex properties are skipped, as are elements after the
-// vertex element. Writes float x y z [vx vy vz] in any of the three encodings; the vertex count
-// is a fixed-width field in the header, patched on commit, so writing streams.
+// scalar property type; elements after the vertex element are skipped.
+//
+// Attributes: every vertex property other than x, y, z is one scalar attribute, named and typed
+// as the header declares it (vx, vy, vz included: PLY has no vector properties, and the reader
+// groups none; the velocity is vx vy vz, and `speed` in convert is its magnitude). Writes float x y z [vx vy vz] in any
+// of the three encodings; the vertex count is a fixed-width field in the header, patched on commit, so writing streams.
 #include <array>
 #include <bit>
 #include <cctype>
@@ -48,6 +51,28 @@ std::optional<PlyType> plyTypeFromName(const std::string& name) {
   for (const auto& entry : kPlyTypeNames)
     if (name == entry.name) return entry.type;
   return std::nullopt;
+}
+
+ValueType valueTypeOf(PlyType type) {
+  switch (type) {
+    case PlyType::Int8:
+      return ValueType::Int8;
+    case PlyType::UInt8:
+      return ValueType::UInt8;
+    case PlyType::Int16:
+      return ValueType::Int16;
+    case PlyType::UInt16:
+      return ValueType::UInt16;
+    case PlyType::Int32:
+      return ValueType::Int32;
+    case PlyType::UInt32:
+      return ValueType::UInt32;
+    case PlyType::Float32:
+      return ValueType::Float32;
+    case PlyType::Float64:
+      return ValueType::Float64;
+  }
+  return ValueType::Float32;
 }
 
 std::size_t plyTypeBytes(PlyType type) {
@@ -232,6 +257,15 @@ class PlyReader final : public ParticleSource {
         throw FileError(path, std::string("PLY vertex element has no property '") + names[i] + "' (needs x, y, z)");
     }
     mHasVelocity = options.velocity && mFields[3] && mFields[4] && mFields[5];
+    for (std::size_t p = 0; p < mHeader.vertexProperties.size(); ++p)
+      if (p != *mFields[0] && p != *mFields[1] && p != *mFields[2]) {
+        const PlyProperty& prop = mHeader.vertexProperties[p];
+        mAttributes.push_back({prop.name, valueTypeOf(prop.type), 1});
+        mAttributeProperty.push_back(p);
+      }
+    const std::vector<std::size_t> selected = selectAttributes(mAttributes, options, path);
+    for (std::size_t index : selected) mSelected.push_back(mAttributeProperty[index]);
+    mColumns = makeColumns(mAttributes, selected);
     if (mHeader.encoding != PlyEncoding::Ascii) {
       std::uint64_t available = mFile.size() - mHeader.dataOffset;
       if (available / mHeader.vertexBytes < mHeader.vertexCount) throw truncated(available / mHeader.vertexBytes);
@@ -241,6 +275,10 @@ class PlyReader final : public ParticleSource {
           PlyType type = mHeader.vertexProperties[*mFields[i]].type;
           mDecoders[i] = swap ? binaryDecoder<true>(type) : binaryDecoder<false>(type);
         }
+      for (std::size_t p : mSelected) {
+        PlyType type = mHeader.vertexProperties[p].type;
+        mSelectedDecoders.push_back(swap ? binaryDecoder<true>(type) : binaryDecoder<false>(type));
+      }
     }
   }
 
@@ -248,14 +286,17 @@ class PlyReader final : public ParticleSource {
   std::string format() const override { return "PLY " + mHeader.formatName + " 1.0"; }
   bool hasVelocity() const override { return mHasVelocity; }
   std::optional<std::uint64_t> countHint() const override { return mHeader.vertexCount; }
+  std::vector<AttributeDesc> attributes() const override { return mAttributes; }
 
   bool read(ParticleChunk& chunk, std::size_t maxParticles) override {
     FLIPSCOPE_CHECK(maxParticles > 0);
     chunk.clear();
+    syncColumns(chunk.attributes, mColumns);
     std::uint64_t n = std::min<std::uint64_t>(maxParticles, mHeader.vertexCount - mNext);
     if (n == 0) return false;
     chunk.positions.resize(n);
     if (mHasVelocity) chunk.velocities.resize(n);
+    for (auto& column : chunk.attributes) column.values.resize(n);
     if (mHeader.encoding == PlyEncoding::Ascii)
       readAscii(chunk, n);
     else
@@ -292,6 +333,12 @@ class PlyReader final : public ParticleSource {
       if (mHasVelocity)
         for (int c = 0; c < 3; ++c) chunk.velocities[k][c] = mDecoders[3 + c](record + offsets[3 + c]);
     }
+    for (std::size_t a = 0; a < mSelected.size(); ++a) {
+      const std::size_t offset = mHeader.vertexProperties[mSelected[a]].offset;
+      const BinaryDecoder decode = mSelectedDecoders[a];
+      float* out = chunk.attributes[a].values.data();
+      for (std::uint64_t k = 0; k < n; ++k) out[k] = decode(mBuffer.data() + k * stride + offset);
+    }
   }
 
   void readAscii(ParticleChunk& chunk, std::uint64_t n) {
@@ -320,9 +367,9 @@ class PlyReader final : public ParticleSource {
         throw FileError(mFile.path(), "line " + std::to_string(lineNumber) + ": expected " +
                                           std::to_string(props.size()) + " values for a vertex, found " +
                                           std::to_string(words.size()));
-      auto value = [&](int field) {
-        const PlyProperty& prop = props[*mFields[field]];
-        std::string_view word = words[*mFields[field]];
+      auto value = [&](std::size_t property) {
+        const PlyProperty& prop = props[property];
+        std::string_view word = words[property];
         if (word.size() > 1 && word[0] == '+') word.remove_prefix(1);
         float result = 0;
         std::from_chars_result parsed;
@@ -335,12 +382,13 @@ class PlyReader final : public ParticleSource {
         }
         if (parsed.ec != std::errc() || parsed.ptr != word.data() + word.size())
           throw FileError(mFile.path(), "line " + std::to_string(lineNumber) + ": malformed number '" +
-                                            std::string(words[*mFields[field]]) + "' for property '" + prop.name + "'");
+                                            std::string(words[property]) + "' for property '" + prop.name + "'");
         return result;
       };
-      for (int c = 0; c < 3; ++c) chunk.positions[k][c] = value(c);
+      for (int c = 0; c < 3; ++c) chunk.positions[k][c] = value(*mFields[c]);
       if (mHasVelocity)
-        for (int c = 0; c < 3; ++c) chunk.velocities[k][c] = value(3 + c);
+        for (int c = 0; c < 3; ++c) chunk.velocities[k][c] = value(*mFields[3 + c]);
+      for (std::size_t a = 0; a < mSelected.size(); ++a) chunk.attributes[a].values[k] = value(mSelected[a]);
     }
   }
 
@@ -349,6 +397,11 @@ class PlyReader final : public ParticleSource {
   std::optional<std::size_t> mFields[6];  ///< property index of x y z vx vy vz
   BinaryDecoder mDecoders[6] = {};
   bool mHasVelocity = false;
+  std::vector<AttributeDesc> mAttributes;        ///< every property but x y z, in header order
+  std::vector<std::size_t> mAttributeProperty;   ///< property index of each of mAttributes
+  std::vector<std::size_t> mSelected;            ///< property index of each column read
+  std::vector<BinaryDecoder> mSelectedDecoders;  ///< binary: decoder of each column read
+  std::vector<AttributeColumn> mColumns;         ///< the columns read, empty
   std::uint64_t mNext = 0;
   std::vector<std::byte> mBuffer;
   std::string mLine;

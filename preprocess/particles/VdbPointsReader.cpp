@@ -8,8 +8,17 @@
 // transform, tree topology and the multi-pass point buffers (OpenVDB 4 and later, file format
 // 224): per leaf the voxel offsets, the position attribute P and the velocity attribute (`v`,
 // else Blender Mantaflow's `particles_velocity*`), in any of OpenVDB's vec3s codecs, paged or
-// not, blosc-compressed or not. Other attributes and other grids are skipped by their sizes.
+// not, blosc-compressed or not. Other grids are skipped by their sizes.
 // World positions are transform.indexToWorld(voxel coordinate + P), computed as OpenVDB does.
+//
+// Attributes: attributes() lists every attribute of the descriptors except P (the velocity
+// included) whose value type OpenVDB names (bool, int8 .. int64, uint8 .. uint64, float, double,
+// vec2/3/4 s/d/i, quats/d, mat3/4 s/d), with the descriptor's value type and its components: the
+// attributes every leaf of every grid read has, in the order of the first descriptor. Asked-for
+// attributes are decoded into columns for every codec OpenVDB registers for their type (null;
+// trnc for float, vec3s and Blender Mantaflow's int32; fxpt8/16, ufxpt8/16 and uvec for vec3s,
+// fxpt for float), paged or not, blosc-compressed or not. Group membership arrays (codec grp) and
+// string indices (codec str) are listed but refused when asked for, as is any other codec.
 //
 // Memory: opening keeps a few dozen bytes a leaf (where its data lies); reading decodes one
 // leaf and one page of each attribute at a time, so a file larger than memory streams.
@@ -187,6 +196,108 @@ constexpr Vec3Codec vec3Codec() {
   return {sizeof(typename Codec::template Storage<Vec3f>::Type), &decodeWith<Codec>};
 }
 
+/// How one value of an attribute is stored: its bytes, its components, and a decoder that
+/// writes the components as floats.
+struct AttributeCodec {
+  std::size_t bytes = 0;
+  int arity = 1;
+  void (*decode)(const std::byte* stored, float* out) = nullptr;
+};
+
+/// Decodes one value of type T (made of Elem components) stored by Codec.
+template <class T, class Elem, class Codec>
+void decodeComponents(const std::byte* stored, float* out) {
+  typename Codec::template Storage<T>::Type storage;
+  std::memcpy(&storage, stored, sizeof storage);
+  T value;
+  Codec::decode(storage, value);
+  constexpr std::size_t n = sizeof(T) / sizeof(Elem);
+  Elem parts[n];
+  std::memcpy(parts, &value, sizeof parts);
+  for (std::size_t i = 0; i < n; ++i) out[i] = static_cast<float>(parts[i]);
+}
+
+/// A value type and codec as a descriptor names them, and how to list and decode them.
+struct CodecEntry {
+  std::string type, codec;
+  ValueType valueType;
+  AttributeCodec decoder;
+};
+
+template <class T, class Elem, class Codec>
+CodecEntry codecEntry(ValueType valueType) {
+  static_assert(sizeof(T) % sizeof(Elem) == 0);
+  return {openvdb::typeNameAsString<T>(),
+          Codec::name(),
+          valueType,
+          {sizeof(typename Codec::template Storage<T>::Type), int(sizeof(T) / sizeof(Elem)),
+           &decodeComponents<T, Elem, Codec>}};
+}
+
+/// Every value type flipscope lists, with each codec it decodes for it: those OpenVDB registers
+/// (points::internal::initialize), Mantaflow's int32 trnc, and the null codec of the other
+/// value types OpenVDB names.
+const std::vector<CodecEntry>& codecTable() {
+  namespace p = openvdb::points;
+  namespace m = openvdb::math;
+  using V = ValueType;
+  static const std::vector<CodecEntry> table{
+      codecEntry<bool, bool, p::NullCodec>(V::UInt8),
+      codecEntry<std::int8_t, std::int8_t, p::NullCodec>(V::Int8),
+      codecEntry<std::int16_t, std::int16_t, p::NullCodec>(V::Int16),
+      codecEntry<std::int32_t, std::int32_t, p::NullCodec>(V::Int32),
+      codecEntry<std::int32_t, std::int32_t, p::TruncateCodec>(V::Int32),
+      codecEntry<std::int64_t, std::int64_t, p::NullCodec>(V::Int64),
+      codecEntry<std::uint8_t, std::uint8_t, p::NullCodec>(V::UInt8),
+      codecEntry<std::uint16_t, std::uint16_t, p::NullCodec>(V::UInt16),
+      codecEntry<std::uint32_t, std::uint32_t, p::NullCodec>(V::UInt32),
+      codecEntry<std::uint64_t, std::uint64_t, p::NullCodec>(V::UInt64),
+      codecEntry<float, float, p::NullCodec>(V::Float32),
+      codecEntry<float, float, p::TruncateCodec>(V::Float32),
+      codecEntry<float, float, p::FixedPointCodec<true, p::PositionRange>>(V::Float32),
+      codecEntry<float, float, p::FixedPointCodec<false, p::PositionRange>>(V::Float32),
+      codecEntry<float, float, p::FixedPointCodec<true, p::UnitRange>>(V::Float32),
+      codecEntry<float, float, p::FixedPointCodec<false, p::UnitRange>>(V::Float32),
+      codecEntry<double, double, p::NullCodec>(V::Float64),
+      codecEntry<Vec3f, float, p::NullCodec>(V::Float32),
+      codecEntry<Vec3f, float, p::TruncateCodec>(V::Float32),
+      codecEntry<Vec3f, float, p::FixedPointCodec<true, p::PositionRange>>(V::Float32),
+      codecEntry<Vec3f, float, p::FixedPointCodec<false, p::PositionRange>>(V::Float32),
+      codecEntry<Vec3f, float, p::FixedPointCodec<true, p::UnitRange>>(V::Float32),
+      codecEntry<Vec3f, float, p::FixedPointCodec<false, p::UnitRange>>(V::Float32),
+      codecEntry<Vec3f, float, p::UnitVecCodec>(V::Float32),
+      codecEntry<Vec3d, double, p::NullCodec>(V::Float64),
+      codecEntry<m::Vec3<std::int32_t>, std::int32_t, p::NullCodec>(V::Int32),
+      codecEntry<m::Vec2<float>, float, p::NullCodec>(V::Float32),
+      codecEntry<m::Vec2<double>, double, p::NullCodec>(V::Float64),
+      codecEntry<m::Vec2<std::int32_t>, std::int32_t, p::NullCodec>(V::Int32),
+      codecEntry<m::Vec4<float>, float, p::NullCodec>(V::Float32),
+      codecEntry<m::Vec4<double>, double, p::NullCodec>(V::Float64),
+      codecEntry<m::Vec4<std::int32_t>, std::int32_t, p::NullCodec>(V::Int32),
+      codecEntry<m::Quat<float>, float, p::NullCodec>(V::Float32),
+      codecEntry<m::Quat<double>, double, p::NullCodec>(V::Float64),
+      codecEntry<m::Mat3<float>, float, p::NullCodec>(V::Float32),
+      codecEntry<m::Mat3<double>, double, p::NullCodec>(V::Float64),
+      codecEntry<m::Mat4<float>, float, p::NullCodec>(V::Float32),
+      codecEntry<m::Mat4<double>, double, p::NullCodec>(V::Float64),
+  };
+  return table;
+}
+
+/// The entry of a value type (any codec), for listing; null for a type flipscope does not know.
+const CodecEntry* findValueType(const std::string& type) {
+  for (const auto& entry : codecTable())
+    if (entry.type == type) return &entry;
+  return nullptr;
+}
+
+/// The decoder of a value type and codec; null when flipscope cannot decode them.
+const AttributeCodec* findAttributeCodec(const std::string& type, const std::string& codec) {
+  for (const auto& entry : codecTable())
+    if (entry.type == type && entry.codec == codec) return &entry.decoder;
+  return nullptr;
+}
+
 /// The codecs OpenVDB registers for vec3s attributes (points::internal::initialize).
 const Vec3Codec* findVec3Codec(const std::string& name) {
   namespace p = openvdb::points;
@@ -292,6 +403,14 @@ struct Descriptor {
   std::map<std::string, std::size_t> names;                ///< name -> index, sorted as OpenVDB's
   std::size_t position = SIZE_MAX;                         ///< index of P
   std::size_t velocity = SIZE_MAX;                         ///< `v`, else `particles_velocity*`
+  /// Per attribute index: its slot among the attributes to decode (VdbParser::extraNames), or -1.
+  std::vector<int> slots;
+  /// The attribute index of `slot`, or SIZE_MAX when this descriptor has no such attribute.
+  std::size_t indexOfSlot(int slot) const {
+    for (std::size_t a = 0; a < slots.size(); ++a)
+      if (slots[a] == slot) return a;
+    return SIZE_MAX;
+  }
   bool operator==(const Descriptor& o) const { return types == o.types && names == o.names; }
 };
 
@@ -361,6 +480,7 @@ struct ArrayInfo {
   std::uint8_t serialization = 0;
   std::uint32_t page = 0;      ///< paged: index of its page in the attribute's page list
   std::uint64_t location = 0;  ///< paged: offset in the page; else file offset of its data
+  bool present = false;        ///< for Leaf::extras: the leaf has this attribute
   bool uniform() const { return serialization & kWriteUniform; }
   bool paged() const { return serialization & kWritePaged; }
   /// Values stored: 1 when uniform (AttributeArray::dataSize otherwise).
@@ -403,6 +523,7 @@ struct Leaf {
   std::uint64_t voxelOffset = 0;  ///< of its voxel data (value mask, size, values)
   std::uint32_t descriptor = 0;
   ArrayInfo position, velocity;
+  std::vector<ArrayInfo> extras;  ///< the attributes to decode, by slot (VdbParser::extraNames)
 };
 
 struct PointGrid {
@@ -424,9 +545,16 @@ std::uint64_t maxDecompressedBytes(std::uint64_t compressedBytes) { return compr
 class VdbParser {
  public:
   VdbParser(ByteInput& input, const std::filesystem::path& path, const ReadOptions& options)
-      : mInput(input), mPath(path), mOptions(options), mCursor(input, path) {}
+      : mInput(input), mPath(path), mOptions(options), mCursor(input, path) {
+    if (!options.allAttributes)
+      for (const auto& name : options.attributes)
+        if (std::find(mExtraNames.begin(), mExtraNames.end(), name) == mExtraNames.end()) mExtraNames.push_back(name);
+  }
 
   std::uint32_t version() const { return mVersion; }
+  /// The attributes whose arrays the leaves keep (Leaf::extras), by slot: those ReadOptions asks
+  /// for by name, or every attribute met but P for allAttributes.
+  const std::vector<std::string>& extraNames() const { return mExtraNames; }
 
   std::vector<PointGrid> parse() {
     Cursor& c = mCursor;
@@ -646,6 +774,7 @@ class VdbParser {
         Descriptor d = readDescriptor(c);
         if (header & 2) c.skip(c.get<std::uint64_t>("descriptor extra bytes"), "descriptor extra bytes");
         if (header > 3) throw c.error("unknown descriptor header flags " + std::to_string(header));
+        assignSlots(d);
         if (grid.descriptors.empty() || !(grid.descriptors.back() == d)) grid.descriptors.push_back(std::move(d));
         leaf.descriptor = std::uint32_t(grid.descriptors.size() - 1);
         if (header & 1) shared = leaf.descriptor;
@@ -658,6 +787,11 @@ class VdbParser {
         arrays.push_back(info.bytes << 2 | std::uint64_t(info.paged()) << 1 | std::uint64_t(info.uniform()));
         if (a == d.position) leaf.position = info;
         if (a == d.velocity) leaf.velocity = info;
+        if (const int slot = d.slots[a]; slot >= 0) {
+          if (leaf.extras.size() <= std::size_t(slot)) leaf.extras.resize(std::size_t(slot) + 1);
+          leaf.extras[std::size_t(slot)] = info;
+          leaf.extras[std::size_t(slot)].present = true;
+        }
       }
     }
     firstArray.push_back(arrays.size());
@@ -699,12 +833,10 @@ class VdbParser {
           throw c.error("attribute " + std::to_string(a) + " of leaf " + std::to_string(l) +
                         " runs past the end of its page");
         Leaf& leaf = grid.leaves[l];
-        const Descriptor& d = grid.descriptors[leaf.descriptor];
-        ArrayInfo* info = a == d.position ? &leaf.position : a == d.velocity ? &leaf.velocity : nullptr;
-        if (info) {
-          info->page = std::uint32_t(grid.pages[a].size() - 1);
-          info->location = byteIndex;
-        }
+        forEachArray(leaf, grid.descriptors[leaf.descriptor], a, [&](ArrayInfo& info) {
+          info.page = std::uint32_t(grid.pages[a].size() - 1);
+          info.location = byteIndex;
+        });
         byteIndex += bytes;
       }
     }
@@ -733,7 +865,6 @@ class VdbParser {
         const std::uint64_t bytes = packed >> 2;
         Leaf& leaf = grid.leaves[l];
         const Descriptor& d = grid.descriptors[leaf.descriptor];
-        ArrayInfo* info = a == d.position ? &leaf.position : a == d.velocity ? &leaf.velocity : nullptr;
         if (packed & 2) {
           if (byteIndex == pageBytes) {
             FLIPSCOPE_CHECK(nextPage < grid.pages[a].size(), "pages of attribute " << a);
@@ -745,13 +876,35 @@ class VdbParser {
           }
           byteIndex += bytes;
         } else {
-          if (info) info->location = offset;
+          forEachArray(leaf, d, a, [&](ArrayInfo& info) { info.location = offset; });
           advance((packed & 1 ? 0 : 1) + bytes, "attribute data");
         }
       }
       FLIPSCOPE_CHECK(nextPage == grid.pages[a].size(), "pages of attribute " << a);
     }
     c.seek(offset, "the end of the grid");
+  }
+
+  /// The slots of `d`'s attributes (Descriptor::slots), adding names for allAttributes.
+  void assignSlots(Descriptor& d) {
+    d.slots.assign(d.types.size(), -1);
+    for (const auto& [name, index] : d.names) {
+      if (index == d.position) continue;
+      auto found = std::find(mExtraNames.begin(), mExtraNames.end(), name);
+      if (found == mExtraNames.end()) {
+        if (!mOptions.allAttributes) continue;
+        found = mExtraNames.insert(mExtraNames.end(), name);
+      }
+      d.slots[index] = int(found - mExtraNames.begin());
+    }
+  }
+
+  /// Calls fn for each array the leaf keeps of attribute index `a`: P, the velocity, an extra.
+  template <class Fn>
+  static void forEachArray(Leaf& leaf, const Descriptor& d, std::size_t a, Fn&& fn) {
+    if (a == d.position) fn(leaf.position);
+    if (a == d.velocity) fn(leaf.velocity);
+    if (const int slot = d.slots[a]; slot >= 0) fn(leaf.extras[std::size_t(slot)]);
   }
 
   /// P and the velocity of every leaf: known codecs, sizes that agree.
@@ -797,6 +950,7 @@ class VdbParser {
   std::uint32_t mCompression = 0;
   std::string mPresent;
   std::map<std::string, std::string> mTypes;  ///< grid name -> type
+  std::vector<std::string> mExtraNames;
 };
 
 // ---- the reader -----------------------------------------------------------------------
@@ -809,7 +963,10 @@ class VdbPointsReader final : public ParticleSource {
       VdbParser parser(*mInput, mPath, mOptions);
       mGrids = parser.parse();
       mFileVersion = parser.version();
+      mExtraNames = parser.extraNames();
     });
+    listAttributes();
+    selectColumns();
     bool any = false;
     mHasVelocity = mOptions.velocity;
     for (const auto& g : mGrids) {
@@ -827,6 +984,7 @@ class VdbPointsReader final : public ParticleSource {
   std::string format() const override { return "OpenVDB points, file format " + std::to_string(mFileVersion); }
   bool hasVelocity() const override { return mHasVelocity; }
   std::optional<std::uint64_t> countHint() const override { return mCount; }
+  std::vector<AttributeDesc> attributes() const override { return mAttributes; }
   /// Particles per active voxel of the topology (no attribute is read): a FLIP solver's
   /// points grid has a voxel per simulation cell, and its particles fill the active ones.
   std::optional<SpacingHint> spacingHint() const override {
@@ -837,6 +995,7 @@ class VdbPointsReader final : public ParticleSource {
   bool read(ParticleChunk& chunk, std::size_t maxParticles) override {
     FLIPSCOPE_CHECK(maxParticles > 0);
     chunk.clear();
+    syncColumns(chunk.attributes, mColumns);
     guarded([&] { readInto(chunk, maxParticles); });
     return chunk.size() > 0;
   }
@@ -855,6 +1014,101 @@ class VdbPointsReader final : public ParticleSource {
     } catch (const std::bad_alloc&) {
       throw FileError(mPath, "out of memory while reading the OpenVDB file");
     }
+  }
+
+  /// attributes(): those every descriptor of every grid read has with the same value type and
+  /// components, P excepted, in the order of the first descriptor's indices.
+  void listAttributes() {
+    bool first = true;
+    for (const PointGrid& g : mGrids)
+      for (const Descriptor& d : g.descriptors) {
+        std::vector<std::string> names(d.types.size());
+        for (const auto& [name, index] : d.names) names[index] = name;
+        std::vector<AttributeDesc> here;
+        for (std::size_t a = 0; a < d.types.size(); ++a) {
+          if (a == d.position) continue;
+          const CodecEntry* entry = findValueType(d.types[a].first);
+          if (!entry) {
+            mUnknownTypes.emplace(names[a], d.types[a].first);
+            continue;
+          }
+          here.push_back({names[a], entry->valueType, entry->decoder.arity});
+        }
+        if (first)
+          mAttributes = std::move(here);
+        else
+          std::erase_if(mAttributes,
+                        [&](const AttributeDesc& a) { return std::find(here.begin(), here.end(), a) == here.end(); });
+        first = false;
+      }
+  }
+
+  /// The columns ReadOptions asks for: each must be decodable in every leaf of every grid read.
+  void selectColumns() {
+    if (!mOptions.allAttributes)
+      for (const auto& name : mOptions.attributes)
+        if (auto unknown = mUnknownTypes.find(name);
+            unknown != mUnknownTypes.end() && std::none_of(mAttributes.begin(), mAttributes.end(),
+                                                           [&](const AttributeDesc& a) { return a.name == name; }))
+          throw FileError(mPath, "attribute " + quote(name) + " has the value type " + quote(unknown->second) +
+                                     ", which flipscope does not read");
+    const std::vector<std::size_t> selected = selectAttributes(mAttributes, mOptions, mPath);
+    mColumns = makeColumns(mAttributes, selected);
+    mColumnSources.assign(mGrids.size(), {});
+    for (std::size_t index : selected) {
+      const std::string& name = mAttributes[index].name;
+      const auto slot = std::find(mExtraNames.begin(), mExtraNames.end(), name);
+      FLIPSCOPE_CHECK(slot != mExtraNames.end(), name);
+      mColumnSlots.push_back(std::size_t(slot - mExtraNames.begin()));
+    }
+    for (std::size_t gi = 0; gi < mGrids.size(); ++gi) {
+      const PointGrid& g = mGrids[gi];
+      for (const Descriptor& d : g.descriptors) {
+        std::vector<ColumnSource> sources;
+        for (std::size_t k = 0; k < mColumnSlots.size(); ++k) {
+          const std::size_t a = d.indexOfSlot(int(mColumnSlots[k]));
+          FLIPSCOPE_CHECK(a != SIZE_MAX, mColumns[k].name);
+          const auto& [type, codecName] = d.types[a];
+          const AttributeCodec* codec = findAttributeCodec(type, codecName);
+          if (!codec)
+            throw FileError(mPath, "grid " + quote(g.name) + ": attribute " + quote(mColumns[k].name) + " is " +
+                                       quote(type) + " stored with the codec " + quote(codecName) +
+                                       (codecName == "grp"   ? " (group membership bits, not values)"
+                                        : codecName == "str" ? " (indices of strings, not values)"
+                                                             : "") +
+                                       ", which flipscope cannot decode");
+          sources.push_back({a, codec});
+        }
+        mColumnSources[gi].push_back(std::move(sources));
+      }
+      for (const Leaf& leaf : g.leaves)
+        for (std::size_t k = 0; k < mColumnSlots.size(); ++k)
+          checkExtra(g, leaf, k, *mColumnSources[gi][leaf.descriptor][k].codec);
+    }
+  }
+
+  /// An extra array's sizes against its points and its codec (as checkArray does for P).
+  void checkExtra(const PointGrid& g, const Leaf& leaf, std::size_t column, const AttributeCodec& codec) const {
+    const ArrayInfo& a = leaf.extras[mColumnSlots[column]];
+    FLIPSCOPE_CHECK(a.present, mColumns[column].name);
+    const std::string what = "attribute " + quote(mColumns[column].name);
+    if (a.serialization & kWriteStrided)
+      throw FileError(mPath, leafName(g, leaf) + ": " + what +
+                                 " is a strided array (several values a point), which flipscope does not read");
+    if (!a.uniform() && a.storedValues() != a.size)
+      throw leafError(
+          g, leaf,
+          what + " stores " + std::to_string(a.storedValues()) + " values for " + std::to_string(a.size) + " points");
+    if (a.size != leaf.position.size)
+      throw leafError(
+          g, leaf,
+          what + " has " + std::to_string(a.size) + " values for " + std::to_string(leaf.position.size) + " positions");
+    const std::uint64_t expected = a.storedValues() * codec.bytes;
+    const bool exact = a.paged() || a.uniform();  // otherwise it may be blosc-compressed
+    if (exact ? a.bytes != expected : a.bytes > expected)
+      throw leafError(
+          g, leaf,
+          what + " holds " + std::to_string(a.bytes) + " bytes for " + std::to_string(expected) + " bytes of values");
   }
 
   void addSpacingHint(const PointGrid& g) {
@@ -948,6 +1202,19 @@ class VdbPointsReader final : public ParticleSource {
     if (mHasVelocity)
       decodeArray(g, leaf, leaf.velocity, d.velocity, d.types[d.velocity].second, mVelocities, mVelocityPage,
                   "velocity");
+    mExtraValues.resize(mColumns.size());
+    mExtraPages.resize(mColumns.size());
+    for (std::size_t k = 0; k < mColumns.size(); ++k) {
+      const ColumnSource& source = mColumnSources[mGrid][leaf.descriptor][k];
+      const ArrayInfo& a = leaf.extras[mColumnSlots[k]];
+      const AttributeCodec& codec = *source.codec;
+      const std::byte* data =
+          arrayBytes(g, leaf, a, source.index, codec.bytes, mExtraPages[k], "attribute " + quote(mColumns[k].name));
+      const std::size_t values = std::size_t(a.storedValues());
+      std::vector<float>& out = mExtraValues[k];
+      out.resize(values * std::size_t(codec.arity));
+      for (std::size_t i = 0; i < values; ++i) codec.decode(data + i * codec.bytes, out.data() + i * codec.arity);
+    }
     mVoxel = 0;
     mPoint = 0;
     mLeafLoaded = true;
@@ -962,11 +1229,21 @@ class VdbPointsReader final : public ParticleSource {
 
   void decodeArray(const PointGrid& g, const Leaf& leaf, const ArrayInfo& a, std::size_t attribute,
                    const std::string& codecName, std::vector<Vec3f>& out, CachedPage& cache, const char* what) {
-    auto fail = [&](const std::string& text) { return leafError(g, leaf, std::string(what) + ": " + text); };
     const Vec3Codec* codec = findVec3Codec(codecName);
     FLIPSCOPE_CHECK(codec, codecName);
+    const std::byte* data = arrayBytes(g, leaf, a, attribute, codec->bytes, cache, what);
     const std::size_t values = std::size_t(a.storedValues());
-    const std::size_t bytes = values * codec->bytes;
+    out.resize(values);
+    for (std::size_t i = 0; i < values; ++i) out[i] = codec->decode(data + i * codec->bytes);
+  }
+
+  /// The stored values of the leaf's array `a` (attribute index `attribute`), `valueBytes` each,
+  /// read and decompressed: valid until the next call.
+  const std::byte* arrayBytes(const PointGrid& g, const Leaf& leaf, const ArrayInfo& a, std::size_t attribute,
+                              std::size_t valueBytes, CachedPage& cache, const std::string& what) {
+    auto fail = [&](const std::string& text) { return leafError(g, leaf, what + ": " + text); };
+    const std::size_t values = std::size_t(a.storedValues());
+    const std::size_t bytes = values * valueBytes;
     const std::byte* data = nullptr;
     if (a.paged()) {
       const Page& page = g.pages[attribute][a.page];
@@ -1005,8 +1282,7 @@ class VdbPointsReader final : public ParticleSource {
         data = stored.data();
       }
     }
-    out.resize(values);
-    for (std::size_t i = 0; i < values; ++i) out[i] = codec->decode(data + i * codec->bytes);
+    return data;
   }
 
   /// Appends points of the loaded leaf from (mVoxel, mPoint) on; true when the leaf is finished.
@@ -1026,6 +1302,11 @@ class VdbPointsReader final : public ParticleSource {
         if (mHasVelocity) {
           const Vec3f& v = mVelocities[uniformV ? 0 : mPoint];
           chunk.velocities.emplace_back(v.x(), v.y(), v.z());
+        }
+        for (std::size_t k = 0; k < mColumns.size(); ++k) {
+          const std::size_t arity = std::size_t(mColumns[k].arity);
+          const float* value = mExtraValues[k].data() + (leaf.extras[mColumnSlots[k]].uniform() ? 0 : mPoint) * arity;
+          chunk.attributes[k].values.insert(chunk.attributes[k].values.end(), value, value + arity);
         }
       }
     }
@@ -1049,6 +1330,19 @@ class VdbPointsReader final : public ParticleSource {
   std::vector<Vec3f> mPositions, mVelocities;
   std::uint32_t mFileVersion = 0;
   CachedPage mPositionPage, mVelocityPage;
+  // Attributes: listed, and the columns read (ReadOptions::attributes).
+  struct ColumnSource {
+    std::size_t index = 0;  ///< attribute index in the descriptor
+    const AttributeCodec* codec = nullptr;
+  };
+  std::vector<std::string> mExtraNames;                                ///< VdbParser::extraNames
+  std::vector<AttributeDesc> mAttributes;                              ///< attributes()
+  std::map<std::string, std::string> mUnknownTypes;                    ///< name -> value type flipscope does not know
+  std::vector<AttributeColumn> mColumns;                               ///< the columns read, empty
+  std::vector<std::size_t> mColumnSlots;                               ///< per column: its slot in Leaf::extras
+  std::vector<std::vector<std::vector<ColumnSource>>> mColumnSources;  ///< [grid][descriptor][column]
+  std::vector<std::vector<float>> mExtraValues;                        ///< per column: the loaded leaf's values
+  std::vector<CachedPage> mExtraPages;
   std::vector<std::byte> mRaw, mDecoded, mScratch;
 };
 

@@ -23,8 +23,10 @@ namespace {
 
 constexpr char kStoreMagic[8] = {'F', 'S', 'S', 'T', 'O', 'R', 'E', '1'};
 /// Fixed part of store.fsh: magic .. particle spacing, store id, run count; then 8 bytes a run
-/// of the frame table, then the checksum.
+/// of the frame table, then the checksum. Version 4 adds the attribute name (length and bytes)
+/// and the attribute range (flag, min, max) before the run count.
 constexpr std::size_t kStoreHeaderFixedBytes = 8 + 4 + 4 + 8 + 24 + 12 + 4 + 8 + 16 + 4;
+constexpr std::size_t kStoreHeaderV4Bytes = 4 + 4 + 4 + 4;
 /// The footer's version field, counted back from the end of the file.
 constexpr std::uint64_t kFooterVersionFromEnd = 24;
 
@@ -128,10 +130,14 @@ void serializeRecord(ByteWriter& w, const BrickRecord& b) {
 
 }  // namespace
 
-const char* attributeName(AttributeKind kind) {
+const char* attributeKindName(AttributeKind kind) {
   switch (kind) {
     case AttributeKind::None: return "none";
     case AttributeKind::Speed: return "speed";
+    case AttributeKind::Scalar:
+      return "scalar";
+    case AttributeKind::Magnitude:
+      return "magnitude";
   }
   return "unknown";
 }
@@ -181,7 +187,10 @@ std::string storeIdText(const StoreId& id) {
 
 // ---- store header ----------------------------------------------------------------------
 
-std::vector<std::byte> serializeStoreHeader(const StoreHeader& h, const std::vector<int>& frames) {
+std::vector<std::byte> serializeStoreHeader(const StoreHeader& h, const std::vector<int>& frames,
+                                            const std::optional<AttributeRange>& range) {
+  FLIPSCOPE_CHECK(h.attributeName.size() <= kMaxAttributeNameBytes, h.attributeName.size());
+  const bool v3 = h.version == 3;
   ByteWriter w;
   w.append(kStoreMagic, sizeof kStoreMagic);
   w.put(h.version);
@@ -196,6 +205,13 @@ std::vector<std::byte> serializeStoreHeader(const StoreHeader& h, const std::vec
   w.put(static_cast<std::uint32_t>(h.attribute));
   w.put(h.particleSpacing);
   w.append(h.id.data(), h.id.size());
+  if (!v3) {
+    w.put(std::uint32_t(h.attributeName.size()));
+    w.append(h.attributeName.data(), h.attributeName.size());
+    w.put(std::uint32_t(range ? 1 : 0));
+    w.put(range ? range->min : 0.0f);
+    w.put(range ? range->max : 0.0f);
+  }
   const auto runs = runsOf(frames);
   w.put(std::uint32_t(runs.size()));
   for (const FrameRun& run : runs) {
@@ -203,20 +219,23 @@ std::vector<std::byte> serializeStoreHeader(const StoreHeader& h, const std::vec
     w.put(run.count);
   }
   w.put(checksum64(w.view()));
-  FLIPSCOPE_CHECK(w.size() == kStoreHeaderFixedBytes + 8 * runs.size() + 8, w.size());
+  FLIPSCOPE_CHECK(w.size() == kStoreHeaderFixedBytes + (v3 ? 0 : kStoreHeaderV4Bytes + h.attributeName.size()) +
+                                  8 * runs.size() + 8,
+                  w.size());
   return std::move(w.bytes());
 }
 
 StoreHeader parseStoreHeader(std::span<const std::byte> bytes, const std::filesystem::path& file,
-                             std::vector<int>* frames) {
+                             std::vector<int>* frames, std::optional<AttributeRange>* rangeOut) {
   ByteReader r(bytes, file);
   auto magic = r.getBytes(8, "magic");
   if (std::memcmp(magic.data(), kStoreMagic, 8) != 0) r.fail("magic", "not a flipscope store header");
   StoreHeader h;
   h.version = r.get<std::uint32_t>("version");
-  if (h.version != kStoreVersion)
-    r.fail("version", "unsupported store version " + std::to_string(h.version) + " (this flipscope reads version " +
-                          std::to_string(kStoreVersion) + "); convert the particle files again into a new store");
+  if (h.version < kOldestStoreVersion || h.version > kStoreVersion)
+    r.fail("version", "unsupported store version " + std::to_string(h.version) + " (this flipscope reads versions " +
+                          std::to_string(kOldestStoreVersion) + " to " + std::to_string(kStoreVersion) +
+                          "); convert the particle files again into a new store");
   h.brickSize = r.get<std::uint32_t>("brick size");
   h.cellSize = r.get<double>("cell size");
   h.origin.x = r.get<double>("origin x");
@@ -229,6 +248,20 @@ StoreHeader parseStoreHeader(std::span<const std::byte> bytes, const std::filesy
   h.particleSpacing = r.get<double>("particle spacing");
   auto id = r.getBytes(h.id.size(), "store id");
   std::memcpy(h.id.data(), id.data(), h.id.size());
+  std::optional<AttributeRange> range;
+  if (h.version >= 4) {
+    const auto length = r.get<std::uint32_t>("attribute name length");
+    if (length > kMaxAttributeNameBytes)
+      r.fail("attribute name length", "longer than " + std::to_string(kMaxAttributeNameBytes));
+    auto name = r.getBytes(length, "attribute name");
+    h.attributeName.assign(reinterpret_cast<const char*>(name.data()), name.size());
+    const auto hasRange = r.get<std::uint32_t>("attribute range flag");
+    AttributeRange values;
+    values.min = r.get<float>("attribute range min");
+    values.max = r.get<float>("attribute range max");
+    if (hasRange > 1) r.fail("attribute range flag", "neither 0 nor 1");
+    if (hasRange) range = values;
+  }
   const auto runCount = r.get<std::uint32_t>("frame table runs");
   if (runCount > r.remaining() / 8) r.fail("frame table runs", "more runs than the file holds");
   std::vector<FrameRun> runs(runCount);
@@ -247,7 +280,17 @@ StoreHeader parseStoreHeader(std::span<const std::byte> bytes, const std::filesy
   for (int a = 0; a < 3; ++a)
     if (h.brickGrid[a] == 0 || std::uint64_t(h.brickGrid[a]) * h.brickSize > 65536)
       throw FileError(file, "invalid brick grid");
-  if (attribute > 1) throw FileError(file, "unknown attribute kind " + std::to_string(attribute));
+  if (attribute > (h.version >= 4 ? 3u : 1u))
+    throw FileError(file, "unknown attribute kind " + std::to_string(attribute));
+  if (h.version == 3 && attribute == 1) h.attributeName = "speed";
+  if ((attribute == 0) != h.attributeName.empty() || (attribute == 1 && h.attributeName != "speed"))
+    throw FileError(file, "attribute name '" + h.attributeName.substr(0, 64) + "' does not fit attribute kind " +
+                              std::to_string(attribute));
+  for (char c : h.attributeName)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+      throw FileError(file, "attribute name has a control character");
+  if (range && (!std::isfinite(range->min) || !std::isfinite(range->max) || range->min > range->max || attribute == 0))
+    throw FileError(file, "invalid attribute range");
   if (!(std::isfinite(h.particleSpacing) && h.particleSpacing >= 0)) throw FileError(file, "invalid particle spacing");
   h.attribute = AttributeKind(attribute);
   // Canonical runs: ascending, separated by a gap, within 0..kMaxFrame.
@@ -264,6 +307,7 @@ StoreHeader parseStoreHeader(std::span<const std::byte> bytes, const std::filesy
     for (const FrameRun& run : runs)
       for (std::uint32_t k = 0; k < run.count; ++k) frames->push_back(run.first + int(k));
   }
+  if (rangeOut) *rangeOut = range;
   return h;
 }
 
@@ -306,6 +350,7 @@ FrameIndex FrameWriter::finish(const FrameStats& stats) {
   footer.frame = mFrame;
   footer.stats = stats;
   footer.storeId = mHeader.id;
+  footer.version = mHeader.version;
   footer.octreeOffset = mFile.offset();
   footer.tableOffset = footer.octreeOffset + 8ull * footer.nodeCount;
   ByteWriter w;
@@ -340,9 +385,11 @@ FrameIndex readFrameIndex(const std::filesystem::path& file, const StoreHeader& 
   // The version first, at the place every version keeps it: an old frame is named as one.
   std::uint32_t version = 0;
   std::memcpy(&version, footerBytes.data() + kFrameFooterBytes - kFooterVersionFromEnd, 4);
-  if (version != kStoreVersion)
-    throw FileError(file, "unsupported frame version " + std::to_string(version) + " (this flipscope reads version " +
-                              std::to_string(kStoreVersion) + "); convert the particle files again into a new store");
+  if (version != header.version)
+    throw FileError(file, "unsupported frame version " + std::to_string(version) + " (the store is version " +
+                              std::to_string(header.version) + ", this flipscope reads versions " +
+                              std::to_string(kOldestStoreVersion) + " to " + std::to_string(kStoreVersion) +
+                              "); convert the particle files again into a new store");
   ByteReader fr(std::span<const std::byte>(footerBytes).first(kFrameFooterBytes - 8), file, footerOffset);
   FrameFooter footer = parseFooter(fr);
   // The index region runs from the octree to the checksum field; check sizes before reading.
@@ -410,7 +457,19 @@ struct BrickStore::Shared {
   std::mutex mutex;
   std::set<int> frames;  ///< the frame table
   std::map<int, std::shared_ptr<const FrameIndex>> indices;
+  std::optional<AttributeRange> range;  ///< version 4: as store.fsh records it
 };
+
+namespace {
+/// `range` widened by the attribute range of `stats` (a frame with particles).
+std::optional<AttributeRange> widened(std::optional<AttributeRange> range, const FrameStats& stats) {
+  if (stats.particles == 0 || !std::isfinite(stats.attributeMin) || !std::isfinite(stats.attributeMax) ||
+      stats.attributeMin > stats.attributeMax)
+    return range;
+  if (!range) return AttributeRange{stats.attributeMin, stats.attributeMax};
+  return AttributeRange{std::min(range->min, stats.attributeMin), std::max(range->max, stats.attributeMax)};
+}
+}  // namespace
 
 bool BrickStore::exists(const std::filesystem::path& dir) {
   std::error_code ec;
@@ -426,9 +485,11 @@ BrickStore BrickStore::open(const std::filesystem::path& dir) {
   BrickStore store;
   store.mDir = dir;
   std::vector<int> frames;
-  store.mHeader = parseStoreHeader(readFile(headerPath), headerPath, &frames);
+  std::optional<AttributeRange> range;
+  store.mHeader = parseStoreHeader(readFile(headerPath), headerPath, &frames, &range);
   store.mShared = std::make_shared<Shared>();
   store.mShared->frames.insert(frames.begin(), frames.end());
+  store.mShared->range = range;
   return store;
 }
 
@@ -438,7 +499,7 @@ BrickStore BrickStore::createOrAppend(const std::filesystem::path& dir, const St
     if (!store.incomplete()) {
       const StoreHeader& h = store.header();
       if (h.brickSize != header.brickSize || h.cellSize != header.cellSize || h.origin != header.origin ||
-          h.brickGrid != header.brickGrid || h.attribute != header.attribute)
+          h.brickGrid != header.brickGrid || h.attribute != header.attribute || h.attributeName != header.attributeName)
         throw FileError(dir, "existing store has a different domain, cell size, brick size or attribute");
       return store;
     }
@@ -485,15 +546,30 @@ std::vector<std::filesystem::path> BrickStore::unlistedFrameFiles() const {
   return files;
 }
 
-void BrickStore::addFrame(int frame) {
+std::optional<AttributeRange> BrickStore::attributeRange() const {
+  if (mHeader.attribute == AttributeKind::None) return std::nullopt;
+  if (mHeader.version >= 4) {
+    std::lock_guard lock(mShared->mutex);
+    return mShared->range;
+  }
+  std::optional<AttributeRange> range;
+  for (int f : frames()) range = widened(range, frame(f)->stats);
+  return range;
+}
+
+void BrickStore::addFrame(int frame, const FrameStats& stats) {
   FLIPSCOPE_CHECK(frame >= 0 && frame <= kMaxFrame, frame);
   std::lock_guard lock(mShared->mutex);
   mShared->indices.erase(frame);
-  if (mShared->frames.count(frame)) return;
+  const std::optional<AttributeRange> range = mHeader.attribute != AttributeKind::None && mHeader.version >= 4
+                                                  ? widened(mShared->range, stats)
+                                                  : mShared->range;
+  if (mShared->frames.count(frame) && range == mShared->range) return;
   std::set<int> frames = mShared->frames;
   frames.insert(frame);
-  writeFileAtomically(mDir / kStoreHeaderName, serializeStoreHeader(mHeader, serializeList(frames)));
+  writeFileAtomically(mDir / kStoreHeaderName, serializeStoreHeader(mHeader, serializeList(frames), range));
   mShared->frames.swap(frames);
+  mShared->range = range;
 }
 
 std::shared_ptr<const FrameIndex> BrickStore::frame(int frame) const {

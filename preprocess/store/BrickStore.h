@@ -4,7 +4,8 @@
 //
 // A store is a directory:
 //   store.fsh               StoreHeader: format version, domain, cell size, brick size, particle
-//                           spacing, the store's random 128-bit id, and the frame table
+//                           spacing, the store's random 128-bit id, the per-particle attribute
+//                           (its kind and name) and its range over the frames, and the frame table
 //   frame_NNNNNN.fsf        one file per frame: brick payloads, then octree, brick table, footer
 // Every file is written atomically (AtomicFile). The frame table in store.fsh lists the frames
 // of the store; it is rewritten (atomically) after each frame file is committed, so after an
@@ -44,8 +45,12 @@
 namespace flipscope {
 
 /// 2: StoreHeader::particleSpacing. 3: the store id (in store.fsh and every frame footer) and
-/// the frame table. Stores of other versions are refused (convert again).
-inline constexpr std::uint32_t kStoreVersion = 3;
+/// the frame table. 4: the attribute's name (any attribute of the input files, not only speed)
+/// and the store's attribute range in store.fsh; frame files unchanged but for their version.
+/// Version 3 stores are read and appended to as version 3 (speed or no attribute; their range
+/// is gathered from the frames); older ones are refused (convert again).
+inline constexpr std::uint32_t kStoreVersion = 4;
+inline constexpr std::uint32_t kOldestStoreVersion = 3;
 inline constexpr char kStoreHeaderName[] = "store.fsh";
 /// Frame numbers a store holds: 0 to kMaxFrame (six digits in the file name).
 inline constexpr int kMaxFrame = 999999;
@@ -55,9 +60,21 @@ using StoreId = std::array<std::uint8_t, 16>;
 StoreId randomStoreId();
 std::string storeIdText(const StoreId& id);  ///< 32 hex digits
 
-/// The per-particle attribute a store carries, quantized to 16 bits over [min, max] of the frame.
-enum class AttributeKind : std::uint32_t { None = 0, Speed = 1 };
-const char* attributeName(AttributeKind kind);
+/// The per-particle attribute a store carries, quantized to 16 bits over [min, max] of the frame:
+/// none, the speed (magnitude of the input's velocity), a scalar attribute of the input files, or
+/// the magnitude of a vector attribute of theirs (StoreHeader::attributeName names it).
+enum class AttributeKind : std::uint32_t { None = 0, Speed = 1, Scalar = 2, Magnitude = 3 };
+/// "none", "speed", "scalar", "magnitude".
+const char* attributeKindName(AttributeKind kind);
+/// Longest StoreHeader::attributeName.
+inline constexpr std::size_t kMaxAttributeNameBytes = 255;
+
+/// Values of the stored attribute, min <= max.
+struct AttributeRange {
+  float min = 0;
+  float max = 0;
+  bool operator==(const AttributeRange&) const = default;
+};
 
 /// Store-wide constants. World position of cell (i,j,k) centre:
 /// origin + (ijk + 0.5) * cellSize. Brick b covers cells [b*brickSize, (b+1)*brickSize).
@@ -68,6 +85,9 @@ struct StoreHeader {
   glm::dvec3 origin{0};               ///< world position of the domain's min corner
   glm::uvec3 brickGrid{0};            ///< bricks per axis (each < kMortonAxisLimit)
   AttributeKind attribute = AttributeKind::None;
+  /// The attribute's name: "speed" for Speed, the input files' name of it for Scalar and
+  /// Magnitude, empty for None. What `info` prints and the EXR channel of `render` is called.
+  std::string attributeName;
   /// World units: the particle spacing convert measured (ParticleSpacing.h), the cube root of
   /// the volume per particle; 0 = unknown. Not part of the domain: appending keeps the store's.
   double particleSpacing = 0;
@@ -159,9 +179,15 @@ class BrickStore {
   /// Reads one brick's compressed payload and verifies its checksum. Thread safe.
   std::vector<std::byte> readPayload(const FrameIndex& frame, std::uint32_t brickIndex) const;
 
-  /// Lists `frame` in the frame table (rewrites store.fsh atomically when it is new). Called
-  /// after the frame file is committed. Throws FileError.
-  void addFrame(int frame);
+  /// The range of the attribute over the store's frames (those with particles): recorded in
+  /// store.fsh since version 4 (a frame converted again widens it, never narrows it), gathered
+  /// from the frames' footers for version 3. nullopt without attribute or particles. Throws
+  /// FileError for a version 3 store with a missing or damaged frame.
+  std::optional<AttributeRange> attributeRange() const;
+
+  /// Lists `frame` in the frame table, widening the attribute range by `stats` (rewrites store.fsh
+  /// atomically when either changes). Called after the frame file is committed. Throws FileError.
+  void addFrame(int frame, const FrameStats& stats = {});
 
  private:
   struct Shared;
@@ -175,13 +201,16 @@ class BrickStore {
 /// the footer's store id is not header.id (a frame of another store).
 FrameIndex readFrameIndex(const std::filesystem::path& file, const StoreHeader& header);
 
-/// store.fsh: the header and the frame table (frames ascending, unique, 0..kMaxFrame; stored as
-/// runs of consecutive frames).
-std::vector<std::byte> serializeStoreHeader(const StoreHeader& header, const std::vector<int>& frames = {});
+/// store.fsh: the header, the attribute range (version 4) and the frame table (frames ascending,
+/// unique, 0..kMaxFrame; stored as runs of consecutive frames), in the layout of header.version
+/// (3, or 4 for every other version).
+std::vector<std::byte> serializeStoreHeader(const StoreHeader& header, const std::vector<int>& frames = {},
+                                            const std::optional<AttributeRange>& range = std::nullopt);
 /// Throws FileError on any truncation, corruption, unknown version or trailing bytes. The frame
-/// table goes to `frames` when given.
+/// table goes to `frames` and the attribute range (version 4; nullopt for version 3) to `range`
+/// when given.
 StoreHeader parseStoreHeader(std::span<const std::byte> bytes, const std::filesystem::path& file,
-                             std::vector<int>* frames = nullptr);
+                             std::vector<int>* frames = nullptr, std::optional<AttributeRange>* range = nullptr);
 
 /// The frame file name of `frame` (frame_NNNNNN.fsf), and back (nullopt for other names).
 std::string frameFileName(int frame);

@@ -29,7 +29,7 @@ struct FrameFooter {
   std::int32_t frame = 0;
   FrameStats stats;
   StoreId storeId{};                ///< the id of the store the frame belongs to (since version 3)
-  std::uint32_t version = kStoreVersion;  ///< 24 bytes before the end in every version
+  std::uint32_t version = kStoreVersion;  ///< the store's; 24 bytes before the end in every version
   std::uint32_t reserved = 0;
   std::uint64_t indexChecksum = 0;  ///< over octree, table and the footer bytes before this field
 };

@@ -22,6 +22,8 @@ FrameSummary summarizeFrame(const FrameIndex& frame, const StoreHeader& header) 
   s.bitsPerParticle = s.particles ? cells / double(s.particles) : 0;
   s.storeBytes = frame.fileBytes;
   s.ratioToRaw = s.storeBytes ? 12.0 * double(s.particles) / double(s.storeBytes) : 0;
+  s.attributeMin = frame.stats.attributeMin;
+  s.attributeMax = frame.stats.attributeMax;
   return s;
 }
 

@@ -20,6 +20,8 @@ struct FrameSummary {
   double bitsPerParticle = 0;  ///< bit-brick representation: bricks x cells per brick / particles (§4.1)
   std::uint64_t storeBytes = 0;
   double ratioToRaw = 0;       ///< raw float32 xyz bytes (12 per particle) / store bytes
+  float attributeMin = 0;      ///< the frame's attribute range (FrameStats)
+  float attributeMax = 0;
 };
 
 FrameSummary summarizeFrame(const FrameIndex& frame, const StoreHeader& header);

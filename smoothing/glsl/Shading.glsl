@@ -7,6 +7,12 @@
 // Inputs: 0 G-buffer (x: unsmoothed depth, y: mask, z: thickness in world units, w: attribute),
 // 1 smoothed normals (xyz, w: mask), 2 sphere normals of the hits (xyz), 3 the equirectangular
 // environment (S.environmentWidth x S.environmentHeight, row 0 at the top) when it has one.
+//
+// Colour by attribute (S.colorBy, render --color-by): one path for every mode but normals. The
+// G-buffer attribute (0..1 over the frame's range) becomes t = w * S.attributeScale +
+// S.attributeOffset (the --color-range) and the colour colorMap(S.colorMap, t) (ColorMap.glsl,
+// included before this file): the albedo of the spheres and of the lit surface, and for the
+// liquid a dye, which tints both the light scattered in it and the background seen through it.
 
 // The procedural environment: a sky that brightens towards the horizon and the sun, over a
 // darker ground, around the scene's up axis.
@@ -43,9 +49,11 @@ FS_FUNC vec3 shEnvironment(vec3 dir) {
   return vec3(texel.x, texel.y, texel.z);
 }
 
-FS_FUNC vec3 shAttributeColour(float a) {
-  return mix(vec3(S.slowColour.x, S.slowColour.y, S.slowColour.z),
-             vec3(S.fastColour.x, S.fastColour.y, S.fastColour.z), clamp(a, 0.0f, 1.0f));
+// The colour of the attribute value `a` (the G-buffer's, 0..1 over the frame's range) through the
+// colour map, when colouring by attribute; else the plain albedo.
+FS_FUNC vec3 shAlbedo(float a) {
+  if (S.colorBy == 0u) return vec3(S.albedo.x, S.albedo.y, S.albedo.z);
+  return colorMap(S.colorMap, a * S.attributeScale + S.attributeOffset);
 }
 
 // Lambert and Blinn from the sun for a surface of colour `albedo`.
@@ -69,12 +77,12 @@ FS_FUNC vec4 shadeSurface(ivec2 p) {
   vec3 colour;
   if (S.mode == kShadeSpheres) {
     vec4 h = ssLoad(2u, p);
-    colour = shLit(shAttributeColour(g.w), normalize(vec3(h.x, h.y, h.z)), view);
+    colour = shLit(shAlbedo(g.w), normalize(vec3(h.x, h.y, h.z)), view);
   } else {
     vec4 nn = ssLoad(1u, p);
     vec3 n = vec3(nn.x, nn.y, nn.z);
     if (S.mode == kShadeAttribute) {
-      colour = shLit(shAttributeColour(g.w), n, view);
+      colour = shLit(shAlbedo(g.w), n, view);
     } else if (S.mode == kShadeNormals) {
       colour = n * 0.5f + vec3(0.5f);
     } else {
@@ -89,6 +97,11 @@ FS_FUNC vec4 shadeSurface(ivec2 p) {
       float lit = 0.45f + 0.55f * max(dot(n, sun), 0.0f);
       vec3 scattered = vec3(S.liquidColour.x, S.liquidColour.y, S.liquidColour.z) * lit;
       vec3 body = behind * transmitted + scattered * (vec3(1.0f) - transmitted);
+      if (S.colorBy != 0u) {
+        // A dyed liquid: the dye's colour filters what passes through and is what it scatters.
+        vec3 dye = shAlbedo(g.w);
+        body = behind * transmitted * dye + dye * lit * (vec3(1.0f) - transmitted);
+      }
       float cosine = clamp(dot(n, view), 0.0f, 1.0f);
       float fresnel = S.fresnelF0 + (1.0f - S.fresnelF0) * pow(1.0f - cosine, 5.0f);
       vec3 reflected = shEnvironment(reflect(ray, n));

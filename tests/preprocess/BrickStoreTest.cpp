@@ -80,6 +80,7 @@ TEST(StoreHeader, RoundTripsAndRejectsEveryCorruption) {
   h.origin = {-1, 2, 3.5};
   h.brickGrid = {4, 5, 6};
   h.attribute = AttributeKind::Speed;
+  h.attributeName = "speed";
   h.particleSpacing = 0.0625;
   auto bytes = serializeStoreHeader(h);
   StoreHeader back = parseStoreHeader(bytes, "store.fsh");
@@ -153,7 +154,7 @@ TEST(BrickStore, VersionOneStoreIsRefusedAskingToConvertAgain) {
       } else {  // appending to it is refused the same way
         ConvertOptions options;
         options.cellSize = 0.05;
-        BrickStore::createOrAppend(dir, makeStoreHeader(Box{{0, 0, 0}, {1, 1, 1}}, options, false));
+        BrickStore::createOrAppend(dir, makeStoreHeader(Box{{0, 0, 0}, {1, 1, 1}}, options));
       }
       FAIL() << "opened a version 1 store";
     } catch (const FileError& e) {
@@ -188,7 +189,7 @@ class SmallStore : public ::testing::Test {
     std::vector<glm::vec3> velocities(positions.size());
     for (std::size_t i = 0; i < velocities.size(); ++i) velocities[i] = {float(i % 7), 1, 0};
     Box bounds{{0, 0, 0}, {20, 20, 20}};
-    BrickStore store = BrickStore::createOrAppend(dir, makeStoreHeader(bounds, options, true));
+    BrickStore store = BrickStore::createOrAppend(dir, makeStoreHeader(bounds, options, AttributeKind::Speed));
     testing::VectorSource source(positions, velocities);
     convertFrame(source, store, 4, options);
   }

@@ -92,7 +92,8 @@ TEST_P(ConvertOracle, StoreMatchesBruteForceBinning) {
   options.progress = Progress::Mode::Silent;
   testing::TempDir temp("oracle");
   const fs::path dir = temp / "store";
-  BrickStore store = BrickStore::createOrAppend(dir, makeStoreHeader(Box{{0, 0, 0}, {12, 12, 12}}, options, c.attribute));
+  const AttributeKind attribute = c.attribute ? AttributeKind::Speed : AttributeKind::None;
+  BrickStore store = BrickStore::createOrAppend(dir, makeStoreHeader(Box{{0, 0, 0}, {12, 12, 12}}, options, attribute));
   testing::VectorSource source(positions, velocities);
   const FrameReport report = convertFrame(source, store, 0, options);
 
@@ -162,7 +163,7 @@ TEST(Convert, OutOfCoreStoreIsByteIdenticalToInCore) {
   auto run = [&](std::uint64_t budget, const std::string& name) {
     options.memoryBudget = budget;
     const fs::path dir = temp / name;
-    StoreHeader header = makeStoreHeader(domain, options, true);
+    StoreHeader header = makeStoreHeader(domain, options, AttributeKind::Speed);
     header.id = {7, 7, 7};  // the same id for both stores: then the files are the same bytes
     BrickStore store = BrickStore::createOrAppend(dir, header);
     testing::VectorSource source(positions, velocities);
@@ -194,7 +195,7 @@ TEST(Convert, SkewedDataSplitsBucketsRecursively) {
   for (std::uint64_t budget : {1ull << 30, 2ull << 20}) {
     options.memoryBudget = budget;
     const fs::path dir = temp / std::to_string(budget);
-    StoreHeader header = makeStoreHeader(domain, options, false);
+    StoreHeader header = makeStoreHeader(domain, options);
     header.id = {1, 2, 3};  // the same id for both stores
     BrickStore store = BrickStore::createOrAppend(dir, header);
     testing::VectorSource source(positions);
@@ -210,13 +211,13 @@ TEST(Convert, SkewedDataSplitsBucketsRecursively) {
 TEST(Convert, DomainIsDerivedFromTheBoundsAndLimited) {
   ConvertOptions options;
   options.resolution = 100;
-  StoreHeader h = makeStoreHeader(Box{{1, 2, 3}, {11, 7, 4}}, options, false);
+  StoreHeader h = makeStoreHeader(Box{{1, 2, 3}, {11, 7, 4}}, options);
   EXPECT_EQ(h.origin, glm::dvec3(1, 2, 3));
   EXPECT_DOUBLE_EQ(h.cellSize, 0.1);
   EXPECT_EQ(h.brickGrid, glm::uvec3(2, 1, 1));
   options.cellSize = 1e-6;
-  EXPECT_THROW(makeStoreHeader(Box{{0, 0, 0}, {1, 1, 1}}, options, false), InputError);
-  EXPECT_THROW(makeStoreHeader(Box{}, ConvertOptions{}, false), InputError);
+  EXPECT_THROW(makeStoreHeader(Box{{0, 0, 0}, {1, 1, 1}}, options), InputError);
+  EXPECT_THROW(makeStoreHeader(Box{}, ConvertOptions{}), InputError);
 }
 
 fs::path mantaflowFrame30() { return fs::path(FLIPSCOPE_DATA_DIR) / "mantaflow-dam64" / "data" / "fluid_data_0030.vdb"; }

@@ -53,7 +53,7 @@ const Box kDomain{{0, 0, 0}, {20, 20, 20}};
 /// A store at `dir` with the given frames, 300 random particles each.
 BrickStore makeStore(const fs::path& dir, const std::vector<int>& frames, unsigned seed = 3) {
   const ConvertOptions options = smallOptions();
-  BrickStore store = BrickStore::createOrAppend(dir, makeStoreHeader(kDomain, options, false));
+  BrickStore store = BrickStore::createOrAppend(dir, makeStoreHeader(kDomain, options));
   for (int f : frames) {
     testing::VectorSource source(testing::randomParticles(300, seed + unsigned(f), 20.0f));
     convertFrame(source, store, f, options);
@@ -81,6 +81,7 @@ long deadPid() {
 
 TEST(StoreHeaderV3, RoundTripsTheIdAndTheFrameTableAndRefusesEveryCorruption) {
   StoreHeader h;
+  h.version = 3;  // the layout of version 3 (version 4 adds the attribute name and range)
   h.brickSize = 64;
   h.cellSize = 0.5;
   h.brickGrid = {3, 2, 1};
@@ -155,7 +156,7 @@ TEST(StoreHeaderV3, VersionTwoStoresAndFramesAreRefusedAskingToConvertAgain) {
   ASSERT_EQ(w.size(), 80u);
   expectFileError(
       [&] { parseStoreHeader(w.view(), "old/store.fsh"); },
-      {"old/store.fsh", "unsupported store version 2", "reads version 3", "convert the particle files again"});
+      {"old/store.fsh", "unsupported store version 2", "reads versions 3 to 4", "convert the particle files again"});
 
   // A version 2 frame file (88-byte footer, version 24 bytes before the end) is named as one.
   testing::TempDir temp("v2-frame");
@@ -212,7 +213,7 @@ TEST(FrameTable, ADeletedMiddleFrameIsMissingAndNamed) {
 TEST(FrameTable, AStoreWithoutFramesIsIncompleteAndTheNextStoreReplacesIt) {
   testing::TempDir temp("incomplete");
   const fs::path dir = temp / "s";
-  BrickStore empty = BrickStore::createOrAppend(dir, makeStoreHeader(kDomain, smallOptions(), false));
+  BrickStore empty = BrickStore::createOrAppend(dir, makeStoreHeader(kDomain, smallOptions()));
   EXPECT_TRUE(BrickStore::open(dir).incomplete());
   const auto problems = checkFrameTable(BrickStore::open(dir));
   ASSERT_EQ(problems.size(), 1u);
@@ -221,14 +222,14 @@ TEST(FrameTable, AStoreWithoutFramesIsIncompleteAndTheNextStoreReplacesIt) {
   // Another domain is no conflict for a store without frames: it starts anew, with a new id.
   ConvertOptions other = smallOptions();
   other.cellSize = 0.5;
-  BrickStore fresh = BrickStore::createOrAppend(dir, makeStoreHeader(kDomain, other, false));
+  BrickStore fresh = BrickStore::createOrAppend(dir, makeStoreHeader(kDomain, other));
   EXPECT_EQ(fresh.header().cellSize, 0.5);
   EXPECT_NE(fresh.header().id, empty.header().id);
   // Once it has a frame, it keeps its header.
   testing::VectorSource source(testing::randomParticles(100, 1, 20.0f));
   convertFrame(source, fresh, 0, other);
   EXPECT_FALSE(BrickStore::open(dir).incomplete());
-  EXPECT_THROW(BrickStore::createOrAppend(dir, makeStoreHeader(kDomain, smallOptions(), false)), FileError);
+  EXPECT_THROW(BrickStore::createOrAppend(dir, makeStoreHeader(kDomain, smallOptions())), FileError);
 }
 
 TEST(FrameTable, AFrameFileTheTableDoesNotListIsNotPartOfTheStore) {

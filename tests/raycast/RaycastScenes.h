@@ -22,7 +22,8 @@ inline BrickStore makeStore(const std::filesystem::path& dir, const std::vector<
   options.cellSize = 1.0;
   options.brickSize = brickSize;
   options.progress = Progress::Mode::Silent;
-  BrickStore store = BrickStore::createOrAppend(dir, makeStoreHeader(*options.domain, options, !velocities.empty()));
+  const AttributeKind attribute = velocities.empty() ? AttributeKind::None : AttributeKind::Speed;
+  BrickStore store = BrickStore::createOrAppend(dir, makeStoreHeader(*options.domain, options, attribute));
   for (std::size_t f = 0; f < frames.size(); ++f) {
     VectorSource source(frames[f], velocities.empty() ? std::vector<glm::vec3>{} : velocities[f]);
     convertFrame(source, store, int(f), options);

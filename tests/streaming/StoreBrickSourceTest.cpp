@@ -27,6 +27,7 @@ class StoreBrickSourceTest : public ::testing::Test {
     header.cellSize = 0.01;
     header.brickGrid = mGrid;
     header.attribute = AttributeKind::Speed;
+    header.attributeName = "speed";
     BrickStore store = BrickStore::createOrAppend(mDir, header);
     std::vector<glm::uvec3> coords = mSynthetic.bricks(1);
     std::sort(coords.begin(), coords.end(),
