@@ -14,7 +14,7 @@
 // positions go straight into the output as the chunks arrive; the velocities come after every
 // position, so they are kept, in their final encoding, in a SpillFile (an unnamed temporary
 // file beside the output: 12 bytes a particle in binary) and appended at commit(). In memory:
-// the header, the spill's 1 MiB buffer and, in ASCII, the text of one chunk.
+// the header, the spill's 1 MiB buffer and, in ASCII, the text of kTextParticles (about 1 MiB).
 //
 // scf1 (ScfOutput): the decoded stream is cut into 1 MiB chunks, each Blosc-compressed as it
 // fills, written in order, then the index ({1 MiB, each chunk's decoded size}, big-endian u64)
@@ -52,6 +52,7 @@ enum class Encoding { Binary, Ascii };
 constexpr std::string_view kFileVersion = "18.5.408";
 constexpr std::int64_t kPageSize = 1024;
 constexpr std::size_t kFlushBytes = std::size_t(1) << 20;
+constexpr std::size_t kTextParticles = std::size_t(1) << 14;  ///< ASCII: formatted this many at a time
 constexpr std::size_t kScfChunkBytes = std::size_t(1) << 20;
 constexpr int kScfLevel = 5;
 constexpr int kAsciiCountWidth = 20;
@@ -282,8 +283,10 @@ class GeoJson {
       mOut.write(data, n * sizeof(glm::vec3));
       return;
     }
-    appendVectorText(mBuffer, data, n, mFirstValue);
-    if (mBuffer.size() >= kFlushBytes) flush();
+    for (std::size_t begin = 0; begin < n; begin += kTextParticles) {
+      appendVectorText(mBuffer, data + begin, std::min(kTextParticles, n - begin), mFirstValue);
+      if (mBuffer.size() >= kFlushBytes) flush();
+    }
   }
   /// Bytes of the array's values as they go in the file (a spill).
   void encodedValues(std::span<const std::byte> bytes) {
@@ -388,9 +391,12 @@ class BgeoWriter final : public ParticleWriter {
       if (mJson.encoding() == Encoding::Binary) {
         mVelocities->write(chunk.velocities.data(), chunk.size() * sizeof(glm::vec3));
       } else {
-        mText.clear();
-        appendVectorText(mText, chunk.velocities.data(), chunk.size(), mFirstVelocity);
-        mVelocities->write(mText.data(), mText.size());
+        for (std::size_t begin = 0; begin < chunk.size(); begin += kTextParticles) {
+          mText.clear();
+          appendVectorText(mText, chunk.velocities.data() + begin, std::min(kTextParticles, chunk.size() - begin),
+                           mFirstVelocity);
+          mVelocities->write(mText.data(), mText.size());
+        }
       }
     }
     mCount += chunk.size();
@@ -474,7 +480,7 @@ class BgeoWriter final : public ParticleWriter {
   std::optional<SpillFile> mVelocities;  ///< in their final encoding
   std::uint64_t mPointCountAt = 0, mPositionLengthAt = 0;
   std::uint64_t mCount = 0;
-  std::string mText;           ///< ASCII: a chunk's velocities
+  std::string mText;           ///< ASCII: velocities as text, kTextParticles at a time
   bool mFirstVelocity = true;  ///< ASCII: no velocity written yet
 };
 
