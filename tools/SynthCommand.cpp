@@ -1,5 +1,6 @@
-// `flipscope synth`: writes procedural FLIP-like frames (preprocess/SynthFluid.h) as raw, PLY or
-// VDB points, chunk by chunk; generation of the next chunk overlaps writing of the current one.
+// `flipscope synth`: writes procedural FLIP-like frames (preprocess/SynthFluid.h) in any writable
+// particle format (raw, PLY, VDB, Houdini bgeo/geo/bgeo.sc, PRT, VTK), chunk by chunk;
+// generation of the next chunk overlaps writing of the current one.
 #include <CLI/CLI.hpp>
 
 #include <cctype>
@@ -13,9 +14,9 @@
 
 #include "core/Error.h"
 #include "core/Progress.h"
+#include "preprocess/SynthFluid.h"
 #include "preprocess/particles/InputSequence.h"
 #include "preprocess/particles/ParticleWriter.h"
-#include "preprocess/SynthFluid.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
 
@@ -113,8 +114,12 @@ void runSynth(const SynthArguments& args) {
 void addSynthCommand(CLI::App& app) {
   auto args = std::make_shared<SynthArguments>();
   auto* cmd = app.add_subcommand(
-      "synth", "Write procedural FLIP-like frames (wavy liquid body, crest sheets, spray) as .bin/.raw, .ply or .vdb");
-  cmd->add_option("-o,--output", args->output, "output file; a frame pattern (####, %04d, {}) for several frames")
+      "synth",
+      "Write procedural FLIP-like frames (wavy liquid body, crest sheets, spray) as .bin/.raw, .ply, .vdb, .bgeo, "
+      ".bgeo.sc, .geo, .prt or .vtk");
+  cmd->add_option("-o,--output", args->output,
+                  "output file, its format by extension: .bin/.raw, .ply, .vdb, .bgeo, .bgeo.sc, .geo, .geo.sc, .prt, "
+                  ".vtk; a frame pattern (####, %04d, {}) for several frames")
       ->required();
   cmd->add_option("--particles", args->particles, "particles a frame, 1k to 1G (suffixes k, M, G)")
       ->capture_default_str();
@@ -123,7 +128,8 @@ void addSynthCommand(CLI::App& app) {
   cmd->add_option("--size", args->size, "horizontal extent of the box in metres, about")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  cmd->add_flag("--velocity", args->velocity, "write velocities (PLY vx vy vz, VDB v; raw has none)");
+  cmd->add_flag("--velocity", args->velocity,
+                "write velocities (PLY vx vy vz, VDB and Houdini v, PRT Velocity, VTK velocity; raw has none)");
   const std::map<std::string, PlyEncoding> encodings = {{"ascii", PlyEncoding::Ascii},
                                                         {"binary", PlyEncoding::BinaryLittleEndian},
                                                         {"binary_be", PlyEncoding::BinaryBigEndian}};

@@ -19,14 +19,15 @@ const std::vector<ParticleFormat>& formatTable() {
       {"vdb", "OpenVDB points (PointDataGrid)", {".vdb"}, detail::isVdb, detail::openVdbPoints, detail::createVdbWriter},
       {"ply", "PLY polygon file, vertices as points", {".ply"}, detail::isPly, detail::openPlyParticles,
        detail::createPlyWriter},
-      {"vtk", "VTK legacy", {".vtk"}, detail::isVtkLegacy, detail::openVtkLegacyParticles, nullptr},
+      {"vtk", "VTK legacy", {".vtk"}, detail::isVtkLegacy, detail::openVtkLegacyParticles,
+       detail::createVtkLegacyWriter},
       {"vtu", "VTK XML unstructured grid", {".vtu", ".vtp"}, detail::isVtkXml, detail::openVtkXmlParticles, nullptr},
       {"bgeo", "Houdini geometry (binary or ASCII JSON)",
        {".bgeo", ".geo", ".bgeo.sc", ".geo.sc", ".bgeo.gz", ".geo.gz"}, detail::isHoudiniJson,
-       detail::openHoudiniJson, nullptr},
+       detail::openHoudiniJson, detail::createBgeoWriter},
       {"bgeo-classic", "Houdini classic geometry (BgeoV / PGEOMETRY)", {".bgeo", ".geo", ".bgeo.gz", ".geo.gz"},
        detail::isClassicBgeo, detail::openClassicBgeo, nullptr},
-      {"prt", "Krakatoa PRT particles", {".prt"}, detail::isPrt, detail::openPrtParticles, nullptr},
+      {"prt", "Krakatoa PRT particles", {".prt"}, detail::isPrt, detail::openPrtParticles, detail::createPrtWriter},
       // By content only (magic 0xFABADA): a ".bin" name means raw floats, below.
       {"realflow-bin", "RealFlow particle cache (.bin, recognised by content)", {}, detail::isRealFlowBin,
        detail::openRealFlowParticles, nullptr},
@@ -127,7 +128,9 @@ std::unique_ptr<ParticleWriter> createParticleWriter(const std::filesystem::path
     std::string writable;
     for (const auto& f : formatTable())
       if (f.create)
-        for (auto extension : f.extensions) writable += (writable.empty() ? "" : ", ") + std::string(extension);
+        for (auto extension : f.extensions)
+          if (!endsWith(extension, ".gz"))  // no writer writes gzip
+            writable += (writable.empty() ? "" : ", ") + std::string(extension);
     throw FileError(path, "cannot write this particle format (writable: " + writable + ")");
   }
   return format->create(path, options);

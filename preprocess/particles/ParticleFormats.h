@@ -34,6 +34,8 @@ std::unique_ptr<ParticleWriter> createVdbWriter(const std::filesystem::path& pat
 /// VTK legacy (.vtk), ASCII or BINARY, POLYDATA and UNSTRUCTURED_GRID (VtkLegacyParticles.cpp).
 bool isVtkLegacy(std::span<const std::byte> head);
 std::unique_ptr<ParticleSource> openVtkLegacyParticles(InputFile file, const ReadOptions& options);
+/// BINARY POLYDATA: POINTS float, POINT_DATA VECTORS velocity float (VtkLegacyWriter.cpp).
+std::unique_ptr<ParticleWriter> createVtkLegacyWriter(const std::filesystem::path& path, const WriteOptions& options);
 /// VTK XML UnstructuredGrid and PolyData (.vtu, .vtp): ascii, base64 and appended data, zlib
 /// (VtuParticles.cpp).
 bool isVtkXml(std::span<const std::byte> head);
@@ -45,6 +47,9 @@ std::optional<std::size_t> vtkVelocityAttribute(const std::vector<AttributeDesc>
 /// and ASCII JSON .geo, as points with their numeric point attributes.
 bool isHoudiniJson(std::span<const std::byte> head);
 std::unique_ptr<ParticleSource> openHoudiniJson(InputFile file, const ReadOptions& options);
+/// Points only, P and v: .bgeo, .geo (ASCII), .bgeo.sc and .geo.sc (scf1); refuses .gz
+/// (BgeoWriter.cpp).
+std::unique_ptr<ParticleWriter> createBgeoWriter(const std::filesystem::path& path, const WriteOptions& options);
 
 /// Houdini's "seekable compressed" container (.sc: "scf1", Blosc chunks, an index, "1fcs"),
 /// decoded with random access (houdini/ScfContainer.cpp).
@@ -62,6 +67,8 @@ std::unique_ptr<ParticleSource> openClassicBgeo(InputFile file, const ReadOption
 /// Krakatoa PRT 1.0 and 1.1, every channel type (PrtParticles.cpp).
 bool isPrt(std::span<const std::byte> head);
 std::unique_ptr<ParticleSource> openPrtParticles(InputFile file, const ReadOptions& options);
+/// PRT 1.0: Position and Velocity float32[3] (PrtWriter.cpp).
+std::unique_ptr<ParticleWriter> createPrtWriter(const std::filesystem::path& path, const WriteOptions& options);
 
 /// RealFlow particle cache .bin, versions 1 to 12 (RealFlowParticles.cpp). By content only:
 /// the name ".bin" means raw floats.

@@ -58,6 +58,48 @@ TEST_F(SynthCommand, PlySequenceReadsBackAsTheGeneratedParticles) {
   }
 }
 
+TEST_F(SynthCommand, HoudiniPrtAndVtkReadBackAsTheGeneratedParticles) {
+  SynthOptions options;
+  options.particles = 5000;
+  options.seed = 4;
+  SynthFluid expected(options);
+  for (const std::string extension : {".bgeo", ".bgeo.sc", ".geo", ".prt", ".vtk"}) {
+    const std::string name = "f" + extension;
+    CommandRun run = synth(mDir, "-o " + name + " --particles 5k --seed 4 --velocity");
+    ASSERT_EQ(run.exitCode, 0) << name << ": " << run.output;
+    auto file = openParticleFile(mDir / name);
+    ASSERT_TRUE(file->hasVelocity()) << name;
+    ASSERT_EQ(file->countHint(), expected.count()) << name;
+    ParticleChunk chunk;
+    std::uint64_t index = 0;
+    while (file->read(chunk, 1234)) {
+      for (std::size_t i = 0; i < chunk.size(); ++i, ++index) {
+        glm::vec3 p, v;
+        expected.particle(index, p, &v);
+        ASSERT_EQ(chunk.positions[i], p) << name << " particle " << index;
+        ASSERT_EQ(chunk.velocities[i], v) << name << " particle " << index;
+      }
+    }
+    EXPECT_EQ(index, expected.count()) << name;
+  }
+}
+
+TEST_F(SynthCommand, BgeoScConvertsToAStore) {
+  CommandRun run = synth(mDir, "-o x.bgeo.sc --particles 20k --velocity");
+  ASSERT_EQ(run.exitCode, 0) << run.output;
+  CommandRun convert = testing::runFlipscope("convert x.bgeo.sc -o store", mDir);
+  ASSERT_EQ(convert.exitCode, 0) << convert.output;
+  SynthOptions options;
+  options.particles = 20'000;
+  const std::string particles = std::to_string(SynthFluid(options).count());
+  EXPECT_NE(convert.output.find("frame 0: " + particles + " particles"), std::string::npos) << convert.output;
+  EXPECT_NE(convert.output.find("attribute speed"), std::string::npos) << convert.output;  // from the velocities
+  EXPECT_EQ(convert.output.find("warning"), std::string::npos) << convert.output;
+  CommandRun info = testing::runFlipscope("info store", mDir);
+  ASSERT_EQ(info.exitCode, 0) << info.output;
+  EXPECT_NE(info.output.find(particles), std::string::npos) << info.output;
+}
+
 TEST_F(SynthCommand, BadArgumentsFailWithAMessage) {
   struct Case {
     std::string arguments, message;
