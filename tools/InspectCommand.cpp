@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -38,14 +39,39 @@ struct Range {
 nlohmann::json inspectFile(const std::filesystem::path& path, bool headerOnly) {
   const auto start = std::chrono::steady_clock::now();
   RecognisedInput input = recogniseInput(InputFile(path));
-  ReadOptions options;
-  options.allAttributes = true;
-  const std::unique_ptr<ParticleSource> source = input.format->open(std::move(input.file), options);
+  const ParticleFormat& format = *input.format;
+  std::unique_ptr<ParticleSource> source = format.open(std::move(input.file), ReadOptions{});
   const std::vector<AttributeDesc> attributes = source->attributes();
+  // Every attribute the reader decodes: a file may list some it cannot (OpenVDB group and
+  // string arrays), which are then shown without a range.
+  std::vector<std::string> undecodable;
+  if (!headerOnly && !attributes.empty()) {
+    ReadOptions every;
+    every.allAttributes = true;
+    try {
+      source = openParticleFile(path, every);
+    } catch (const FileError&) {
+      ReadOptions decodable;
+      for (const AttributeDesc& attribute : attributes) {
+        ReadOptions one;
+        one.attributes = {attribute.name};
+        try {
+          auto probe = openParticleFile(path, one);
+          ParticleChunk chunk;
+          probe->read(chunk, 1);
+          decodable.attributes.push_back(attribute.name);
+        } catch (const FileError& e) {
+          undecodable.push_back(attribute.name);
+          std::fprintf(stderr, "inspect: %s\n", e.what());
+        }
+      }
+      source = openParticleFile(path, decodable);
+    }
+  }
 
   nlohmann::json j;
   j["file"] = path.string();
-  j["format"] = input.format->name;
+  j["format"] = format.name;
   j["format_description"] = source->format();
   j["containers"] = input.containers;
   const auto declared = source->countHint();
@@ -69,8 +95,10 @@ nlohmann::json inspectFile(const std::filesystem::path& path, bool headerOnly) {
         else
           ++nonFinitePositions;
       }
-      for (std::size_t a = 0; a < chunk.attributes.size() && a < ranges.size(); ++a) {
-        const AttributeColumn& column = chunk.attributes[a];
+      for (const AttributeColumn& column : chunk.attributes) {
+        std::size_t a = 0;
+        while (a < attributes.size() && attributes[a].name != column.name) ++a;
+        if (a == attributes.size() || attributes[a].arity != column.arity) continue;
         Range& range = ranges[a];
         for (std::size_t i = 0; i < column.values.size(); ++i) {
           const double v = column.values[i];
@@ -96,7 +124,9 @@ nlohmann::json inspectFile(const std::filesystem::path& path, bool headerOnly) {
     nlohmann::json attribute{{"name", attributes[a].name},
                              {"type", std::string(valueTypeName(attributes[a].type))},
                              {"arity", attributes[a].arity}};
-    if (!headerOnly) {
+    const bool decoded = std::find(undecodable.begin(), undecodable.end(), attributes[a].name) == undecodable.end();
+    attribute["decoded"] = !headerOnly && decoded;
+    if (!headerOnly && decoded) {
       const bool any = !ranges[a].min.empty() && std::isfinite(ranges[a].min[0]);
       attribute["min"] = any ? nlohmann::json(ranges[a].min) : nlohmann::json(nullptr);
       attribute["max"] = any ? nlohmann::json(ranges[a].max) : nlohmann::json(nullptr);
@@ -104,6 +134,7 @@ nlohmann::json inspectFile(const std::filesystem::path& path, bool headerOnly) {
     }
     j["attributes"].push_back(std::move(attribute));
   }
+  j["undecodable_attributes"] = undecodable;
   j["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return j;
 }
@@ -141,7 +172,9 @@ void printFile(const nlohmann::json& j) {
     std::printf("  attributes  %-16s %-8s %5s  %s\n", "name", "type", "arity", j.contains("points") ? "range" : "");
     for (const auto& a : j["attributes"]) {
       std::string range;
-      if (a.contains("min"))
+      if (j.contains("points") && !a["decoded"].get<bool>())
+        range = "not decoded (flipscope does not read this kind of attribute)";
+      else if (a.contains("min"))
         range = !a["min"].is_null()         ? numbers(a["min"]) + " to " + numbers(a["max"])
                 : j.value("points", 0) == 0 ? "no values (no points)"
                                             : "no finite values";

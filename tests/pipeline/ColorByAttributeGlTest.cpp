@@ -2,6 +2,8 @@
 // reference: the colour and the image's attribute channel.
 #include <gtest/gtest.h>
 
+#include "GlTestSupport.h"
+
 #include <cmath>
 
 #include "TestSupport.h"
@@ -26,7 +28,7 @@ TEST(ColorByAttributeGl, EqualsTheCpuReference) {
   try {
     gpu.emplace(store, DeviceChoice::Gpu, ball.settings(), surface);
   } catch (const gl::Unavailable& e) {
-    GTEST_SKIP() << "no EGL/OpenGL 4.5 device: " << e.what();
+    FLIPSCOPE_SKIP_WITHOUT_GL(e.what());
   }
   FramePipeline cpu(store, DeviceChoice::Cpu, ball.settings(), surface);
   const FrameOutput a = gpu->render(0, ball.camera()), b = cpu.render(0, ball.camera());

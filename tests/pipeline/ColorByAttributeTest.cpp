@@ -61,7 +61,9 @@ TEST(ColorByAttribute, ChangesTheLiquidAndTheSpheresAndTheMapsDiffer) {
     EXPECT_GT(mapPixels, 500);
     // Background pixels (no hit) are the same in every image.
     for (std::size_t i = 0; i < plain.rgba.size(); ++i)
-      if (!std::isfinite(plain.depth[i])) ASSERT_EQ(plain.rgba[i], viridis.rgba[i]) << i;
+      if (!std::isfinite(plain.depth[i])) {
+        ASSERT_EQ(plain.rgba[i], viridis.rgba[i]) << i;
+      }
   }
 }
 

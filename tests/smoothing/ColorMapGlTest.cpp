@@ -3,6 +3,8 @@
 // spheres and lit-surface modes, with and without a colour range.
 #include <gtest/gtest.h>
 
+#include "GlTestSupport.h"
+
 #include "gl/EglContext.h"
 #include "smoothing/CpuScreenDevice.h"
 #include "smoothing/GpuScreenDevice.h"
@@ -16,7 +18,7 @@ TEST(ColorMapGl, GpuShadingMatchesTheCpuReferenceForEveryMap) {
   try {
     context = gl::EglContext::create();
   } catch (const gl::Unavailable& e) {
-    GTEST_SKIP() << "no EGL/OpenGL 4.5 device: " << e.what();
+    FLIPSCOPE_SKIP_WITHOUT_GL(e.what());
   }
   GpuScreenDevice gpu("test");
   CpuScreenDevice cpu;
