@@ -327,11 +327,24 @@ class PlyReader final : public ParticleSource {
     std::size_t offsets[6] = {};
     for (int i = 0; i < 6; ++i)
       if (mFields[i]) offsets[i] = mHeader.vertexProperties[*mFields[i]].offset;
-    for (std::uint64_t k = 0; k < n; ++k) {
-      const std::byte* record = mBuffer.data() + k * stride;
-      for (int c = 0; c < 3; ++c) chunk.positions[k][c] = mDecoders[c](record + offsets[c]);
-      if (mHasVelocity)
-        for (int c = 0; c < 3; ++c) chunk.velocities[k][c] = mDecoders[3 + c](record + offsets[3 + c]);
+    // The common case, little-endian float32 fields, is plain copies (no call a value).
+    bool plainFloats = mHeader.encoding == PlyEncoding::BinaryLittleEndian;
+    for (int i = 0; i < (mHasVelocity ? 6 : 3); ++i)
+      plainFloats = plainFloats && mHeader.vertexProperties[*mFields[i]].type == PlyType::Float32;
+    if (plainFloats) {
+      for (std::uint64_t k = 0; k < n; ++k) {
+        const std::byte* record = mBuffer.data() + k * stride;
+        for (int c = 0; c < 3; ++c) std::memcpy(&chunk.positions[k][c], record + offsets[c], 4);
+        if (mHasVelocity)
+          for (int c = 0; c < 3; ++c) std::memcpy(&chunk.velocities[k][c], record + offsets[3 + c], 4);
+      }
+    } else {
+      for (std::uint64_t k = 0; k < n; ++k) {
+        const std::byte* record = mBuffer.data() + k * stride;
+        for (int c = 0; c < 3; ++c) chunk.positions[k][c] = mDecoders[c](record + offsets[c]);
+        if (mHasVelocity)
+          for (int c = 0; c < 3; ++c) chunk.velocities[k][c] = mDecoders[3 + c](record + offsets[3 + c]);
+      }
     }
     for (std::size_t a = 0; a < mSelected.size(); ++a) {
       const std::size_t offset = mHeader.vertexProperties[mSelected[a]].offset;
