@@ -166,7 +166,9 @@ void runBenchPreprocess(const BenchPreprocessArgs& a) {
   std::printf("store: %u bricks, %s bytes = %.3f of raw float32 (target <= 0.25): %s\n", frame.bricks,
               Progress::humanCount(double(frame.storeBytes)).c_str(), double(frame.storeBytes) / rawFloatBytes,
               double(frame.storeBytes) / rawFloatBytes <= 0.25 ? "met" : "NOT met");
-  std::printf("peak RSS %s bytes with --mem %s\n", Progress::humanCount(double(peakResidentBytes())).c_str(), a.mem.c_str());
+  std::printf("peak RSS of this bench process %s bytes (convert --mem %s%s)\n",
+              Progress::humanCount(double(peakResidentBytes())).c_str(), a.mem.c_str(),
+              formats.formats.empty() ? "" : "; it read every format of the table below too");
   if (!formats.formats.empty()) printFormatTable(formatResult, formats);
 }
 
