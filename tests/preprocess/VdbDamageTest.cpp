@@ -118,6 +118,9 @@ TEST(VdbDamage, MantaflowFiles) {
     const Sweep sweep = mutateBytes(f.name, original, f.step);
     std::printf("%s (%zu bytes, every %zu. byte): %zu changes, %zu refused, none crashed\n", f.name, original.size(),
                 f.step, sweep.mutations, sweep.refused);
+    // A floor under what the README's table records (5 % to 100 % refused): a reader that
+    // accepted damaged files as valid would fall below it.
+    EXPECT_GT(sweep.refused, sweep.mutations / 50) << f.name;
   }
 }
 
@@ -129,6 +132,7 @@ TEST(VdbDamage, OpenVdbWrittenVariants) {
     const Sweep sweep = mutateBytes(name, original, std::max<std::size_t>(1, original.size() / 2000));
     std::printf("%s (%zu bytes): %zu changes, %zu refused, none crashed\n", name.c_str(), original.size(),
                 sweep.mutations, sweep.refused);
+    EXPECT_GT(sweep.refused, 0u) << name;
     // The last grid of a file without grid offsets is not read when it is not points: its end
     // cannot be found without decoding it, and it cannot change the particles.
     if (!file.unreadTail) truncateEverywhere(name, original, std::max<std::size_t>(1, original.size() / 1000));

@@ -36,6 +36,7 @@ class ConvertMemory : public ::testing::TestWithParam<std::string> {};
 TEST_P(ConvertMemory, PeakStaysWithinTheBudgetPlusTheFixedOverhead) {
   testing::TempDir dir("convert-memory");
   const std::string input = "synth." + GetParam();
+  // (GetParam() names the format by its extension; gtest names the cases after them.)
   const std::string velocity = GetParam() == "bin" ? "" : " --velocity";  // raw files hold positions only
   const auto synth = testing::runFlipscope("synth -o " + input + " --particles 5M" + velocity, dir.path());
   ASSERT_EQ(synth.exitCode, 0) << synth.output;
@@ -48,7 +49,8 @@ TEST_P(ConvertMemory, PeakStaysWithinTheBudgetPlusTheFixedOverhead) {
   EXPECT_LE(peak, kBudgetMiB + kFixedOverheadMiB) << run.output;
 }
 
-INSTANTIATE_TEST_SUITE_P(EveryWritableFormat, ConvertMemory, ::testing::Values("bin", "ply", "vdb"));
+INSTANTIATE_TEST_SUITE_P(EveryWritableFormat, ConvertMemory,
+                         ::testing::Values("bin", "ply", "vdb", "bgeo", "bgeo.sc", "prt", "vtk"));
 
 }  // namespace
 }  // namespace flipscope
