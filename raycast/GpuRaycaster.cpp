@@ -1,7 +1,9 @@
 #include "raycast/GpuRaycaster.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <cstring>
 
 #include "core/Error.h"
 #include "raycast/CpuRaycaster.h"
@@ -26,8 +28,14 @@ enum Binding : GLuint {
 constexpr std::uint32_t kGroupSize = 8;  // local_size_x and _y of Raycast.comp
 
 /// A buffer of at least `bytes` (GL refuses empty storage; unused bindings get 16 bytes).
+/// Data shorter than 16 bytes is copied into a zeroed block first: GL reads the whole storage
+/// size from `data` (ASan found the overread of a one-node octree).
 gl::Buffer makeBuffer(std::uint64_t bytes, const void* data = nullptr) {
-  return gl::Buffer(std::max<std::uint64_t>(bytes, 16), bytes ? data : nullptr);
+  constexpr std::uint64_t kMinimum = 16;
+  if (bytes >= kMinimum) return gl::Buffer(bytes, data);
+  std::array<std::byte, kMinimum> padded{};
+  if (data && bytes) std::memcpy(padded.data(), data, std::size_t(bytes));
+  return gl::Buffer(kMinimum, data ? padded.data() : nullptr);
 }
 }  // namespace
 

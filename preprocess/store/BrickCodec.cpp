@@ -9,11 +9,34 @@
 #include <zstd.h>
 
 #include <algorithm>
+#include <memory>
 
 #include "core/Bytes.h"
 #include "preprocess/store/BrickStore.h"
 
 namespace flipscope {
+namespace {
+
+struct CompressorDeleter {
+  void operator()(ZSTD_CCtx* context) const { ZSTD_freeCCtx(context); }
+};
+struct DecompressorDeleter {
+  void operator()(ZSTD_DCtx* context) const { ZSTD_freeDCtx(context); }
+};
+
+/// One zstd context per thread, reused by every brick the thread codes and freed when the
+/// thread ends (LeakSanitizer saw raw thread_local pointers outlive their threads).
+ZSTD_CCtx* threadCompressor() {
+  thread_local std::unique_ptr<ZSTD_CCtx, CompressorDeleter> context(ZSTD_createCCtx());
+  return context.get();
+}
+ZSTD_DCtx* threadDecompressor() {
+  thread_local std::unique_ptr<ZSTD_DCtx, DecompressorDeleter> context(ZSTD_createDCtx());
+  return context.get();
+}
+
+}  // namespace
+
 
 std::uint64_t DecodedBrick::particleCount() const {
   std::uint64_t n = 0;
@@ -39,7 +62,7 @@ std::vector<std::byte> encodeBrick(const DecodedBrick& brick, int zstdLevel) {
   raw.putArray(std::span<const std::uint16_t>(brick.attributes));
 
   std::vector<std::byte> out(ZSTD_compressBound(raw.size()));
-  thread_local ZSTD_CCtx* context = ZSTD_createCCtx();
+  ZSTD_CCtx* context = threadCompressor();
   std::size_t n = ZSTD_compressCCtx(context, out.data(), out.size(), raw.view().data(), raw.size(), zstdLevel);
   FLIPSCOPE_CHECK(!ZSTD_isError(n), ZSTD_getErrorName(n));
   out.resize(n);
@@ -56,7 +79,7 @@ constexpr std::uint64_t kOneShotBytes = 4 << 20;
 template <class Fail>
 std::vector<std::byte> decompressStreamed(std::span<const std::byte> payload, std::uint64_t declared,
                                           const Fail& fail) {
-  thread_local ZSTD_DCtx* context = ZSTD_createDCtx();
+  ZSTD_DCtx* context = threadDecompressor();
   ZSTD_DCtx_reset(context, ZSTD_reset_session_only);
   std::vector<std::byte> raw;
   std::size_t produced = 0;
@@ -97,7 +120,7 @@ DecodedBrick decodeBrick(std::span<const std::byte> payload, const std::filesyst
   if (declared == ZSTD_CONTENTSIZE_ERROR || declared == ZSTD_CONTENTSIZE_UNKNOWN)
     throw fail("payload is not a zstd frame of known size");
   if (declared > bound) throw fail("payload declares " + std::to_string(declared) + " bytes, more than possible");
-  thread_local ZSTD_DCtx* context = ZSTD_createDCtx();
+  ZSTD_DCtx* context = threadDecompressor();
   std::vector<std::byte> raw;
   if (declared <= std::max<std::uint64_t>(kOneShotBytes, 64 * std::uint64_t(payload.size()))) {
     raw.resize(declared);
