@@ -15,10 +15,11 @@ CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Re
 ninja -C "$build" -j"${FLIPSCOPE_JOBS:-2}"
 export LSAN_OPTIONS="suppressions=$root/tests/asan.supp:print_suppressions=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
-# Everything but the GL tests, leaks included.
+# The library tests, leaks included.
 ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:detect_stack_use_after_return=0" \
-  ctest --test-dir "$build" -j2 --output-on-failure -LE gl
-# The GL tests: memory errors abort them, but leaks are not checked, since llvmpipe's
-# JIT-compiled code allocates from frames no suppression can name.
+  ctest --test-dir "$build" -j2 --output-on-failure -LE "gl|tools"
+# The GL tests and the command-line tests (whose renders run on llvmpipe): memory errors abort
+# them, but leaks are not checked, since llvmpipe's JIT-compiled code allocates from frames no
+# suppression can name.
 ASAN_OPTIONS="detect_leaks=0:abort_on_error=1:detect_stack_use_after_return=0" \
-  ctest --test-dir "$build" -j2 --output-on-failure -L gl
+  ctest --test-dir "$build" -j2 --output-on-failure -L "gl|tools"
