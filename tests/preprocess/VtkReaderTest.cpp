@@ -202,7 +202,8 @@ TEST(VtkLegacyReader, PointsOnlyAndNoCells) {
   }
   // No points at all is a valid, empty file.
   LegacyVtkOptions options;
-  auto source = openParticleBytes("empty.vtk", bytesOf(testing::legacyVtk({}, {}, options)));
+  const std::string empty = testing::legacyVtk({}, {}, options);  // outlives the source
+  auto source = openParticleBytes("empty.vtk", bytesOf(empty));
   ParticleChunk chunk;
   EXPECT_FALSE(source->read(chunk, 10));
   EXPECT_EQ(source->countHint(), 0u);
@@ -227,7 +228,8 @@ TEST(VtkLegacyReader, VelocityByName) {
   // 'velocity' is preferred over 'v'; a scalar 'v' is no velocity.
   auto v = testing::vtkTestArray("v", ValueType::Float32, 3, n, 26, Kind::Vectors);
   auto velocity = testing::vtkTestArray("velocity", ValueType::Float64, 3, n, 27);
-  auto source = openParticleBytes("v.vtk", bytesOf(testing::legacyVtk(xyz, {v, velocity}, LegacyVtkOptions{})));
+  const std::string both = testing::legacyVtk(xyz, {v, velocity}, LegacyVtkOptions{});  // outlives the source
+  auto source = openParticleBytes("v.vtk", bytesOf(both));
   EXPECT_EQ(testing::readAll(*source, 100).velocities[0],
             glm::vec3(velocity.values[0], velocity.values[1], velocity.values[2]));
   auto scalar = testing::vtkTestArray("v", ValueType::Float32, 1, n, 28, Kind::Scalars);
