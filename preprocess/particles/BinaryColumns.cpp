@@ -87,28 +87,6 @@ void decodeOrdered(ValueType type, const std::byte* first, std::size_t stride, i
 
 }  // namespace
 
-std::size_t valueTypeBytes(ValueType type) {
-  switch (type) {
-    case ValueType::Int8:
-    case ValueType::UInt8:
-      return 1;
-    case ValueType::Int16:
-    case ValueType::UInt16:
-    case ValueType::Float16:
-      return 2;
-    case ValueType::Int32:
-    case ValueType::UInt32:
-    case ValueType::Float32:
-      return 4;
-    case ValueType::Int64:
-    case ValueType::UInt64:
-    case ValueType::Float64:
-      return 8;
-  }
-  FLIPSCOPE_CHECK(false, "unknown value type " << int(type));
-  return 0;
-}
-
 float halfToFloat(std::uint16_t bits) {
   const std::uint32_t sign = std::uint32_t(bits & 0x8000u) << 16;
   const std::uint32_t exponent = (bits >> 10) & 0x1fu;

@@ -10,13 +10,11 @@
 #include <glm/vec3.hpp>
 
 #include "preprocess/particles/ParticleSource.h"
+#include "preprocess/particles/ValueDecode.h"  // valueTypeBytes
 
 namespace flipscope::detail {
 
 enum class ByteOrder : std::uint8_t { Little, Big };
-
-/// Bytes of one component of `type` (1, 2, 4 or 8).
-std::size_t valueTypeBytes(ValueType type);
 
 /// IEEE 754 binary16 to float, exactly (subnormals, infinities and NaN included).
 float halfToFloat(std::uint16_t bits);
