@@ -18,6 +18,7 @@
 #include <map>
 
 #include "ParticleTestSupport.h"
+#include "VdbOracle.h"
 #include "VdbTestFiles.h"
 
 namespace flipscope {
