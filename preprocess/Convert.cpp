@@ -3,7 +3,6 @@
 
 #include <fcntl.h>
 #include <signal.h>
-#include <sys/file.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -23,6 +22,7 @@
 #include "core/Error.h"
 #include "preprocess/BrickBinning.h"
 #include "preprocess/store/FrameFile.h"
+#include "preprocess/store/StoreLock.h"
 #include "preprocess/ParticleSpacing.h"
 
 namespace flipscope {
@@ -460,42 +460,55 @@ StoreHeader chooseHeader(const Box& bounds, const ConvertOptions& options, const
 }
 
 /// The store directory for the length of a convert: created when missing (and then removed
-/// again, on failure or SIGINT/SIGTERM/SIGHUP, if nothing is left in it), and locked (flock)
-/// so that a second convert into the same store is refused instead of racing on store.fsh.
+/// again, on failure or SIGINT/SIGTERM/SIGHUP, if nothing is left in it), and the writer lock
+/// held on it (StoreLock.h): exclusive while this convert is the only writer and cleans up,
+/// then shared, so that any number of converts add frames to it at once.
 class StoreDirectory {
  public:
   explicit StoreDirectory(const std::filesystem::path& dir) : mDir(dir) {
     std::error_code ec;
-    const DeferCleanupSignals step;  // registered and created as one step
-    if (!std::filesystem::exists(dir, ec)) {
-      mCleanup = CleanupOnSignal(dir, CleanupOnSignal::Kind::Directory);
-      if (!std::filesystem::create_directories(dir, ec) && ec)
-        throw OutputError(dir, "cannot create the store directory: " + ec.message());
-      mCreated = true;
-    } else if (!std::filesystem::is_directory(dir, ec)) {
-      throw FileError(dir, "exists and is not a directory (a brick store is one)");
+    {
+      const DeferCleanupSignals step;  // registered and created as one step
+      if (!std::filesystem::exists(dir, ec)) {
+        mCleanup = CleanupOnSignal(dir, CleanupOnSignal::Kind::Directory);
+        if (!std::filesystem::create_directories(dir, ec) && ec)
+          throw OutputError(dir, "cannot create the store directory: " + ec.message());
+        mCreated = true;
+      } else if (!std::filesystem::is_directory(dir, ec)) {
+        throw FileError(dir, "exists and is not a directory (a brick store is one)");
+      }
     }
-    mFd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (mFd < 0) throw FileError(dir, std::string("cannot open the store directory: ") + std::strerror(errno));
-    if (::flock(mFd, LOCK_EX | LOCK_NB) != 0 && errno == EWOULDBLOCK) {
-      ::close(mFd);
-      mFd = -1;
-      throw FileError(dir, "another flipscope convert is writing this store; wait for it to finish");
-    }  // other errors: a filesystem without locks; convert unlocked
+    try {
+      mLock.emplace(dir);
+    } catch (...) {
+      if (mCreated) std::filesystem::remove(dir, ec);
+      throw;
+    }
+    if (!BrickStore::exists(dir)) mLockCleanup = CleanupOnSignal(dir / kStoreLockName);
   }
   ~StoreDirectory() {
-    if (mFd >= 0) ::close(mFd);
+    // No store left (a failed first convert) and no other writer: the lock file goes too, and
+    // the directory when this convert created it.
     std::error_code ec;
+    if (!BrickStore::exists(mDir)) mLock->removeFileIfAlone();
     if (mCreated && std::filesystem::is_empty(mDir, ec)) std::filesystem::remove(mDir, ec);
   }
   StoreDirectory(const StoreDirectory&) = delete;
   StoreDirectory& operator=(const StoreDirectory&) = delete;
 
+  /// No other convert writes this store: this one may remove what dead writers left.
+  bool alone() const { return mLock->alone(); }
+  /// Housekeeping done: other writers may join.
+  void share() { mLock->share(); }
+  /// The store has a frame (or a header to keep): the lock file stays with it.
+  void keepLockFile() { mLockCleanup.release(); }
+
  private:
   std::filesystem::path mDir;
   CleanupOnSignal mCleanup;
+  CleanupOnSignal mLockCleanup;
+  std::optional<StoreWriterLock> mLock;
   bool mCreated = false;
-  int mFd = -1;
 };
 
 /// store.fsh of a store that has no frame yet: removed again when the convert fails (an
@@ -714,19 +727,23 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
   StoredAttribute attribute = chooseAttribute(options.attribute, inputs, held, probe, allVelocity);
 
   ConvertReport report;
-  const StoreDirectory directory(storeDir);
+  StoreDirectory directory(storeDir);
   stopPoint("directory");
   // Left by a killed convert (their writer's PID is gone): temporaries, spill files, and frame
-  // files of this store that its table does not list.
-  noteStaleFiles(removeStaleFiles(storeDir, true), storeDir.string(), report);
+  // files of this store that its table does not list. Only a writer alone in the store removes
+  // them: another writer's are not stale, and a PID says nothing about another machine's.
+  if (directory.alone()) noteStaleFiles(removeStaleFiles(storeDir, true), storeDir.string(), report);
   if (!options.scratchDir.empty() && std::filesystem::is_directory(options.scratchDir))
     noteStaleFiles(removeStaleFiles(options.scratchDir, false), options.scratchDir.string(), report);
   StoreHeader header;
   bool keepHeader = false;
+  if (options.append && !BrickStore::exists(storeDir))
+    throw FileError(storeDir, std::string("--append: not a brick store (no ") + kStoreHeaderName +
+                                  "); make it with a first convert, or convert --prepare");
   if (BrickStore::exists(storeDir)) {
     const BrickStore existing = BrickStore::open(storeDir);
     StaleFiles unlisted;
-    for (const auto& file : existing.unlistedFrameFiles()) {
+    for (const auto& file : directory.alone() ? existing.unlistedFrameFiles() : std::vector<std::filesystem::path>{}) {
       try {
         readFrameIndex(file, existing.header());  // a complete frame of this store, never listed
       } catch (const FileError&) {
@@ -739,7 +756,7 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
       if (std::filesystem::remove(file, ec)) ++unlisted.files, unlisted.bytes += bytes;
     }
     noteStaleFiles(unlisted, storeDir.string() + " (frame files never listed in store.fsh)", report);
-    if (!existing.incomplete()) {
+    if (!existing.incomplete() || options.append) {
       header = existing.header();
       keepHeader = true;
       const StoredAttribute kept{header.attribute, header.attributeName};
@@ -752,11 +769,17 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
       attribute = kept;
       report.cellSizeOrigin = "kept from the existing store";
       report.spacingOrigin = "the existing store";
-    } else {
+    } else if (directory.alone()) {
+      // Left by an interrupted or failed first convert: removed while no other writer can
+      // have joined it. (A store without frames that another writer is creating now is joined.)
+      std::error_code ec;
+      std::filesystem::remove(storeDir / kStoreHeaderName, ec);
       report.warnings.push_back(storeDir.string() +
                                 ": the store has no frames (an interrupted or failed convert); starting it anew");
     }
   }
+  // Housekeeping done: from here on other writers may add frames beside this one.
+  directory.share();
   // What every later pass reads: the stored attribute's column, velocities only for speed.
   ConvertOptions reading = options;
   reading.read = probe;
@@ -789,24 +812,30 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
     }
     header = chooseHeader(bounds, options, attribute, spacing, report);
   }
-  std::optional<FramelessHeader> frameless;
+  std::optional<FramelessHeader> framelessHeader;
   std::optional<BrickStore> created;
   {
     const DeferCleanupSignals step;  // store.fsh registered and written as one step
-    if (!keepHeader) frameless.emplace(storeDir / kStoreHeaderName);
-    created = BrickStore::createOrAppend(storeDir, header);
+    if (!keepHeader) framelessHeader.emplace(storeDir / kStoreHeaderName);
+    created = BrickStore::createOrAppend(storeDir, header, BrickStore::FramelessStore::Join);
   }
   BrickStore& store = *created;
   report.header = store.header();
   stopPoint("header");
+  if (options.prepareOnly) {
+    if (framelessHeader) framelessHeader->keep();
+    directory.keepLockFile();
+    return report;
+  }
   Progress progress("convert", hinted, "particles", options.progress);
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     progress.setLabel("convert frame " + std::to_string(inputs[i].frame) + " (" + std::to_string(i + 1) + "/" +
                       std::to_string(inputs.size()) + ")");
     auto source = openFrame(inputs[i], reading.read);
-    report.frames.push_back(
-        convertOneFrame(*source, store, inputs[i].frame, reading, &progress, frameless ? &*frameless : nullptr));
-    frameless.reset();  // kept: the store has a frame
+    report.frames.push_back(convertOneFrame(*source, store, inputs[i].frame, reading, &progress,
+                                            framelessHeader ? &*framelessHeader : nullptr));
+    framelessHeader.reset();  // kept: the store has a frame
+    directory.keepLockFile();
   }
   progress.setLabel("convert");
   std::uint64_t bricks = 0, bytes = 0;

@@ -21,10 +21,14 @@
 // or the grid would exceed kMaxCellsPerAxis. The spacing is measured and recorded in the
 // store header either way (StoreHeader::particleSpacing).
 //
-// Interruptions (see BrickStore.h for the frame table): convert() locks the store directory
-// (flock; a second convert into it is refused), removes what a killed convert left there (AtomicFile
-// temporaries and spill files whose PID is gone, and frame files of the store that its table
-// never listed), then commits each frame file before listing it in store.fsh. A new store's
+// Concurrent writers: any number of convert() calls, in any processes and on any machines of a
+// shared filesystem, may add frames to one store at once (StoreLock.h). They must agree on the
+// header: a store with frames (or one made by prepareOnly, joined with `append`) keeps its own.
+//
+// Interruptions (see BrickStore.h for the frame table): convert() takes the store's writer lock;
+// when no other convert is writing the store, it removes what a killed convert left there
+// (AtomicFile temporaries and spill files whose PID is gone, and frame files of the store that
+// its table never listed); then it commits each frame file before listing it in store.fsh. A new store's
 // store.fsh (no frames yet) and a directory convert() created are removed again when it fails
 // before the first frame. Every temporary, spill file and not yet listed frame file is registered
 // with CleanupOnSignal, so SIGINT, SIGTERM and SIGHUP remove them once the command installed
@@ -78,6 +82,13 @@ struct ConvertOptions {
   std::optional<std::string> attribute;
   int zstdLevel = 1;
   std::filesystem::path scratchDir;    ///< spill files; default: the store directory
+  /// Add to the store at storeDir, which must exist, with its header: also a store with no
+  /// frames yet (made by prepareOnly), which is otherwise started anew. What farm tasks do.
+  bool append = false;
+  /// Write the store header (domain, cell size and attribute as a convert of `inputs` would
+  /// choose them; the particle spacing measured on the first frame) and no frames: a store that
+  /// concurrent converts then fill with `append`.
+  bool prepareOnly = false;
   ReadOptions read;
   Progress::Mode progress = Progress::Mode::Auto;
 };

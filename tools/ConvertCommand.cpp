@@ -28,6 +28,8 @@ struct ConvertArgs {
   std::string attribute = "auto";
   int zstdLevel = 1;
   std::string scratch;
+  bool append = false;
+  bool prepare = false;
   bool quiet = false;
 };
 
@@ -43,6 +45,8 @@ void runConvert(const ConvertArgs& a) {
   if (a.attribute != "auto") options.attribute = a.attribute;
   options.zstdLevel = a.zstdLevel;
   options.scratchDir = a.scratch;
+  options.append = a.append;
+  options.prepareOnly = a.prepare;
   options.read.grids = a.grids;
   options.progress = a.quiet ? Progress::Mode::Silent : Progress::Mode::Auto;
 
@@ -54,6 +58,13 @@ void runConvert(const ConvertArgs& a) {
 
   if (a.quiet) return;
   const StoreHeader& h = report.header;
+  if (a.prepare) {
+    std::printf("store %s prepared: cell size %g (%s), bricks of %u^3, grid %ux%ux%u bricks, attribute %s, no "
+                "frames yet\n",
+                a.store.c_str(), h.cellSize, report.cellSizeOrigin.c_str(), h.brickSize, h.brickGrid.x, h.brickGrid.y,
+                h.brickGrid.z, describeAttribute(h).c_str());
+    return;
+  }
   std::printf("store %s: cell size %g (%s), bricks of %u^3, grid %ux%ux%u bricks, attribute %s\n", a.store.c_str(),
               h.cellSize, report.cellSizeOrigin.c_str(), h.brickSize, h.brickGrid.x, h.brickGrid.y, h.brickGrid.z,
               describeAttribute(h).c_str());
@@ -108,6 +119,13 @@ void addConvertCommand(CLI::App& app) {
       ->check(CLI::Range(-5, 19))
       ->capture_default_str();
   cmd->add_option("--scratch", args->scratch, "Directory for spill files (default: the store)");
+  auto* prepare = cmd->add_flag("--prepare", args->prepare,
+                                "Write only the store header (domain, cell size, attribute), for converts that then "
+                                "--append frames at the same time (what farm convert does)");
+  cmd->add_flag("--append", args->append,
+                "Add the frames to the existing store -o, keeping its header (also one made by --prepare); "
+                "any number of converts may add frames to one store at once")
+      ->excludes(prepare);
   cmd->add_flag("-q,--quiet", args->quiet, "No progress and no summary");
   cmd->callback([args] { runConvert(*args); });
 }

@@ -17,6 +17,7 @@
 #include "core/Hash.h"
 #include "core/Morton.h"
 #include "preprocess/store/FrameFile.h"
+#include "preprocess/store/StoreLock.h"
 
 namespace flipscope {
 namespace {
@@ -493,23 +494,28 @@ BrickStore BrickStore::open(const std::filesystem::path& dir) {
   return store;
 }
 
-BrickStore BrickStore::createOrAppend(const std::filesystem::path& dir, const StoreHeader& header) {
+BrickStore BrickStore::createOrAppend(const std::filesystem::path& dir, const StoreHeader& header,
+                                      FramelessStore frameless) {
+  std::error_code created;
+  std::filesystem::create_directories(dir, created);
+  if (created) throw OutputError(dir, "cannot create the store directory: " + created.message());
+  const StoreTableLock table(dir);  // two writers creating one store agree on one header
   if (exists(dir)) {
     BrickStore store = open(dir);
-    if (!store.incomplete()) {
+    if (!store.incomplete() || frameless == FramelessStore::Join) {
       const StoreHeader& h = store.header();
       if (h.brickSize != header.brickSize || h.cellSize != header.cellSize || h.origin != header.origin ||
           h.brickGrid != header.brickGrid || h.attribute != header.attribute || h.attributeName != header.attributeName)
-        throw FileError(dir, "existing store has a different domain, cell size, brick size or attribute");
+        throw FileError(dir, store.incomplete()
+                                 ? "another convert is creating this store with a different domain, cell size, "
+                                   "brick size or attribute"
+                                 : "existing store has a different domain, cell size, brick size or attribute");
       return store;
     }
   }
   StoreHeader fresh = header;
   fresh.version = kStoreVersion;
   if (fresh.id == StoreId{}) fresh.id = randomStoreId();
-  std::error_code created;
-  std::filesystem::create_directories(dir, created);
-  if (created) throw OutputError(dir, "cannot create the store directory: " + created.message());
   writeFileAtomically(dir / kStoreHeaderName, serializeStoreHeader(fresh));
   return open(dir);
 }
@@ -561,13 +567,31 @@ void BrickStore::addFrame(int frame, const FrameStats& stats) {
   FLIPSCOPE_CHECK(frame >= 0 && frame <= kMaxFrame, frame);
   std::lock_guard lock(mShared->mutex);
   mShared->indices.erase(frame);
-  const std::optional<AttributeRange> range = mHeader.attribute != AttributeKind::None && mHeader.version >= 4
-                                                  ? widened(mShared->range, stats)
-                                                  : mShared->range;
-  if (mShared->frames.count(frame) && range == mShared->range) return;
+  const StoreTableLock table(mDir);
+  // Other writers may have listed frames since this store was opened: start from store.fsh as it
+  // is now. (A writer whose first frame failed removes a store.fsh without frames; this one
+  // writes it again, with the same id.)
+  const auto headerPath = mDir / kStoreHeaderName;
   std::set<int> frames = mShared->frames;
+  std::optional<AttributeRange> listedRange = mShared->range;
+  bool listed = false;
+  std::error_code ec;
+  if (std::filesystem::exists(headerPath, ec)) {
+    std::vector<int> onDisk;
+    const StoreHeader now = parseStoreHeader(readFile(headerPath), headerPath, &onDisk, &listedRange);
+    if (now.id != mHeader.id)
+      throw FileError(headerPath, "is now the header of another store (store " + storeIdText(now.id) + ", not " +
+                                      storeIdText(mHeader.id) +
+                                      "): a convert started the store anew while this one wrote frame " +
+                                      std::to_string(frame));
+    frames = {onDisk.begin(), onDisk.end()};
+    listed = frames.count(frame) != 0;
+  }
+  std::optional<AttributeRange> range = listedRange;
+  if (mHeader.attribute != AttributeKind::None && mHeader.version >= 4) range = widened(range, stats);
   frames.insert(frame);
-  writeFileAtomically(mDir / kStoreHeaderName, serializeStoreHeader(mHeader, serializeList(frames), range));
+  if (!listed || range != listedRange)
+    writeFileAtomically(headerPath, serializeStoreHeader(mHeader, serializeList(frames), range));
   mShared->frames.swap(frames);
   mShared->range = range;
 }

@@ -7,9 +7,13 @@
 //                           spacing, the store's random 128-bit id, the per-particle attribute
 //                           (its kind and name) and its range over the frames, and the frame table
 //   frame_NNNNNN.fsf        one file per frame: brick payloads, then octree, brick table, footer
+//   store.lock              the writers' locks (StoreLock.h); readers ignore it
 // Every file is written atomically (AtomicFile). The frame table in store.fsh lists the frames
 // of the store; it is rewritten (atomically) after each frame file is committed, so after an
-// interruption at any moment every listed frame is complete. A frame file the table does not
+// interruption at any moment every listed frame is complete. Any number of writers may add
+// frames to one store at once, on one machine or over a shared filesystem (store.lock,
+// StoreLock.h); two writers of the same frame each rename a complete file into place, and
+// the last one wins. A frame file the table does not
 // list is not part of the store (readers ignore it; the next convert removes it when it carries
 // the store's id). A store whose table is empty is incomplete (an interrupted or failed first
 // convert): `info` refuses it and the next convert into it starts it anew. Each frame file's
@@ -151,11 +155,16 @@ class BrickStore {
   /// Opens an existing store; reads and verifies the header and its frame table. Frame indices
   /// load lazily. Throws FileError. A store with no frames opens (see incomplete()).
   static BrickStore open(const std::filesystem::path& dir);
+  /// What createOrAppend does with an existing store that has no frames yet: replace it (an
+  /// interrupted first convert, when its writer is alone in the store), or join it (a store made
+  /// by `convert --prepare`, or one that another writer is creating now).
+  enum class FramelessStore { Replace, Join };
   /// Creates a new store directory with `header` (its id, or a random one when it is all
-  /// zero), or, if a store with frames exists, checks that its header matches (same brick size,
-  /// cell size, origin, grid, attribute) and opens it for appending. An incomplete store (no
-  /// frames) is replaced by a new one with `header`.
-  static BrickStore createOrAppend(const std::filesystem::path& dir, const StoreHeader& header);
+  /// zero), or, if a store with frames exists (or one without, to join), checks that its header
+  /// matches (same brick size, cell size, origin, grid, attribute) and opens it for appending.
+  /// Under the table lock (StoreLock.h), so concurrent writers agree on one store.
+  static BrickStore createOrAppend(const std::filesystem::path& dir, const StoreHeader& header,
+                                   FramelessStore frameless = FramelessStore::Replace);
   static bool exists(const std::filesystem::path& dir);
 
   const std::filesystem::path& directory() const { return mDir; }
@@ -186,7 +195,9 @@ class BrickStore {
   std::optional<AttributeRange> attributeRange() const;
 
   /// Lists `frame` in the frame table, widening the attribute range by `stats` (rewrites store.fsh
-  /// atomically when either changes). Called after the frame file is committed. Throws FileError.
+  /// atomically when either changes). Called after the frame file is committed. Under the table
+  /// lock, merging the frames other writers listed meanwhile (StoreLock.h). Throws FileError,
+  /// also when store.fsh now belongs to another store (started anew meanwhile).
   void addFrame(int frame, const FrameStats& stats = {});
 
  private:

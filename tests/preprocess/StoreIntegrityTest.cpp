@@ -262,7 +262,7 @@ TEST(FrameTable, ListingAFrameRewritesTheTableOnceAndOpenReadsNoDirectory) {
   EXPECT_EQ(readFile(dir / kStoreHeaderName), before);
   EXPECT_EQ(BrickStore::open(dir).frame(5)->stats.particles, 50u);
   EXPECT_EQ(namesIn(dir), (std::vector<std::string>{"frame_000004.fsf", "frame_000005.fsf", "frame_000009.fsf",
-                                                    "store.fsh"}));
+                                                    "store.fsh", "store.lock"}));
 }
 
 TEST(StaleFiles, TemporaryNamesCarryTheWritersPid) {
@@ -433,7 +433,7 @@ TEST(ConvertCleanup, AConvertRemovesTheStaleFilesAndUnlistedFramesOfAKilledOne) 
   EXPECT_NE(warnings.find("frame files never listed"), std::string::npos) << warnings;
   EXPECT_NE(warnings.find("frame_000007.fsf: not in the store's frame table"), std::string::npos) << warnings;
   EXPECT_EQ(namesIn(dir), (std::vector<std::string>{"frame_000001.fsf", "frame_000004.fsf", "frame_000007.fsf",
-                                                    "store.fsh"}));
+                                                    "store.fsh", "store.lock"}));
   EXPECT_TRUE(fs::is_empty(scratch));
   EXPECT_EQ(BrickStore::open(dir).frames(), (std::vector<int>{1, 4}));
 }
@@ -460,7 +460,7 @@ TEST(ConvertCleanup, AFailedConvertLeavesNoStoreBehind) {
   convert({FrameInput{0, {input}}}, temp / "kept", options);
   options.scratchDir = temp / "no" / "such" / "dir";
   EXPECT_THROW(convert({FrameInput{1, {input}}}, temp / "kept", options), FileError);
-  EXPECT_EQ(namesIn(temp / "kept"), (std::vector<std::string>{"frame_000000.fsf", "store.fsh"}));
+  EXPECT_EQ(namesIn(temp / "kept"), (std::vector<std::string>{"frame_000000.fsf", "store.fsh", "store.lock"}));
   EXPECT_EQ(BrickStore::open(temp / "kept").frames(), std::vector<int>{0});
 }
 

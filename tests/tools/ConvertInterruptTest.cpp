@@ -9,7 +9,6 @@
 
 #include <fcntl.h>
 #include <signal.h>
-#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -23,6 +22,8 @@
 #include <vector>
 
 #include "TestSupport.h"
+#include "preprocess/store/BrickStore.h"
+#include "preprocess/store/StoreLock.h"
 
 extern char** environ;
 
@@ -192,7 +193,7 @@ class ConvertInterrupt : public ::testing::Test {
     }
     const std::vector<std::string> after = namesIn(store);
     EXPECT_EQ(after, (std::vector<std::string>{"frame_000001.fsf", "frame_000002.fsf", "frame_000003.fsf",
-                                               "store.fsh"}))
+                                               "store.fsh", "store.lock"}))
         << join(after);
     EXPECT_EQ(verifiedFrames(store, code, output), (std::vector<int>{1, 2, 3})) << output;
     EXPECT_EQ(code, 0) << output;
@@ -365,15 +366,45 @@ TEST_F(StoreIntegrityCli, AFailedConvertLeavesNoStore) {
   EXPECT_FALSE(fs::exists(dir / "s")) << join(namesIn(dir / "s"));
 }
 
-TEST_F(StoreIntegrityCli, ASecondConvertIntoTheSameStoreIsRefusedWhileOneRuns) {
+TEST_F(StoreIntegrityCli, AConvertBesideAnotherWriterLeavesItsFilesAlone) {
   convert("s");
-  const int fd = ::open((dir / "s").c_str(), O_RDONLY | O_DIRECTORY);
-  ASSERT_GE(fd, 0);
-  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);  // as a running convert holds it
-  CommandRun second = run("convert " + path("f_####.bin") + " -o " + path("s") + " -q");
-  ::close(fd);
-  EXPECT_EQ(second.exitCode, 3) << second.output;
-  EXPECT_NE(second.output.find("another flipscope convert is writing this store"), std::string::npos) << second.output;
+  // What a writer may have in the store while it runs: a temporary (its PID, here one that no
+  // process has) and a complete frame file not listed yet.
+  const fs::path temporary = dir / "s" / ".frame_000009.fsf.tmp-999999999-1";
+  std::ofstream(temporary) << "partial";
+  fs::copy_file(dir / "s" / "frame_000004.fsf", dir / "s" / "frame_000005.fsf");
+  {
+    flipscope::StoreWriterLock other(dir / "s");  // as a running convert holds it
+    other.share();
+    CommandRun beside = run("convert " + path("f_####.bin") + " --frames 2 -o " + path("s"));
+    EXPECT_EQ(beside.exitCode, 0) << beside.output;
+    EXPECT_TRUE(fs::exists(temporary));
+    EXPECT_TRUE(fs::exists(dir / "s" / "frame_000005.fsf"));
+    EXPECT_EQ(beside.output.find("removed"), std::string::npos) << beside.output;
+  }
+  // Alone, a convert removes both: their writer is gone.
+  CommandRun alone = run("convert " + path("f_####.bin") + " --frames 3 -o " + path("s"));
+  EXPECT_EQ(alone.exitCode, 0) << alone.output;
+  EXPECT_FALSE(fs::exists(temporary));
+  EXPECT_FALSE(fs::exists(dir / "s" / "frame_000005.fsf"));
+  EXPECT_EQ(run("info --verify " + path("s")).exitCode, 0);
+}
+
+TEST_F(StoreIntegrityCli, AppendNeedsAStoreAndPrepareMakesOneWithoutFrames) {
+  CommandRun append = run("convert " + path("f_####.bin") + " -o " + path("s") + " --append");
+  EXPECT_EQ(append.exitCode, 3) << append.output;
+  EXPECT_NE(append.output.find(path("s") + ": --append: not a brick store"), std::string::npos) << append.output;
+  EXPECT_FALSE(fs::exists(dir / "s"));
+  CommandRun prepare = run("convert " + path("f_####.bin") + " -o " + path("s") + " --prepare --resolution 64");
+  ASSERT_EQ(prepare.exitCode, 0) << prepare.output;
+  EXPECT_NE(prepare.output.find("no frames yet"), std::string::npos) << prepare.output;
+  EXPECT_EQ(run("info " + path("s")).exitCode, 3);  // incomplete until a frame is added
+  // --append joins the prepared store (its id and header) instead of starting it anew.
+  const flipscope::StoreId id = flipscope::BrickStore::open(dir / "s").header().id;
+  CommandRun first = run("convert " + path("f_####.bin") + " --frames 1 -o " + path("s") + " --append");
+  ASSERT_EQ(first.exitCode, 0) << first.output;
+  EXPECT_EQ(first.output.find("starting it anew"), std::string::npos) << first.output;
+  EXPECT_EQ(flipscope::BrickStore::open(dir / "s").header().id, id);
   EXPECT_EQ(run("info --verify " + path("s")).exitCode, 0);
 }
 
