@@ -582,6 +582,19 @@ StaleFiles removeStaleFiles(const std::filesystem::path& dir, bool temporaries) 
   return removed;
 }
 
+Box scanInputBounds(const std::vector<FrameInput>& inputs, const ConvertOptions& options, std::uint64_t particles) {
+  ReadOptions read = options.read;
+  read.velocity = false;
+  read.attributes.clear();
+  read.allAttributes = false;
+  Progress progress("scan bounds", particles, "particles", options.progress);
+  const MemoryPlan plan(options.memoryBudget, false);
+  Box bounds;
+  for (const auto& input : inputs) bounds.extend(scanBounds(*openFrame(input, read), plan.chunkParticles, &progress));
+  progress.finish();
+  return bounds;
+}
+
 StoreHeader makeStoreHeader(const Box& bounds, const ConvertOptions& options, AttributeKind attribute,
                             const std::string& attributeName) {
   if (options.brickSize != 32 && options.brickSize != 64 && options.brickSize != 128)
@@ -800,11 +813,7 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
     if (options.domain) {
       bounds = *options.domain;
     } else {
-      Progress progress("scan bounds", hinted, "particles", options.progress);
-      const MemoryPlan plan(options.memoryBudget, false);
-      for (const auto& input : inputs)
-        bounds.extend(scanBounds(*openFrame(input, reading.read), plan.chunkParticles, &progress));
-      progress.finish();
+      bounds = scanInputBounds(inputs, reading, hinted);
       if (bounds.isEmpty())
         throw InputError(inputFileNames(inputs) +
                          ": no finite particle positions (no particles, or only NaN/Inf ones): cannot derive a "

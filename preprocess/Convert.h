@@ -127,6 +127,11 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
 StoreHeader makeStoreHeader(const Box& bounds, const ConvertOptions& options,
                             AttributeKind attribute = AttributeKind::None, const std::string& attributeName = "");
 
+/// The bounds of the finite particle positions of every frame of `inputs` (options.read and
+/// options.memoryBudget apply): the domain convert() derives without one. An empty box when
+/// there are none. `particles`: how many to expect, for the progress line (0: unknown).
+Box scanInputBounds(const std::vector<FrameInput>& inputs, const ConvertOptions& options, std::uint64_t particles = 0);
+
 /// What removeStaleFiles() removed.
 struct StaleFiles {
   std::uint64_t files = 0;

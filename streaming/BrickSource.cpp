@@ -2,6 +2,12 @@
 #include "streaming/BrickSource.h"
 
 #include <algorithm>
+#include <limits>
+
+#include <glm/common.hpp>
+#include <glm/vector_relational.hpp>
+
+#include "core/Error.h"
 
 namespace flipscope {
 
@@ -18,6 +24,45 @@ std::shared_ptr<const DecodedBrick> StoreBrickSource::read(const BrickKey& key) 
   std::int64_t index = frame->octree.find(key.coord);
   if (index < 0) return nullptr;
   return std::make_shared<const DecodedBrick>(mStore.readBrick(*frame, std::uint32_t(index)));
+}
+
+Box occupiedBounds(BrickSource& source, int first, int last) {
+  const StoreHeader& h = source.header();
+  std::vector<std::shared_ptr<const FrameIndex>> frames;
+  glm::uvec3 lo(~0u), hi(0u);
+  for (int f = first; f <= last; ++f) {
+    frames.push_back(source.frame(f));
+    for (const BrickRecord& record : frames.back()->bricks) {
+      lo = glm::min(lo, record.coord);
+      hi = glm::max(hi, record.coord);
+    }
+  }
+  if (lo.x > hi.x) return {};  // no bricks in any frame
+  // Bricks on the outer layers of all frames decide the bounds: decode them (up to a limit over
+  // the whole range) for cell-exact bounds, so a default camera frames the fluid, not its bricks.
+  constexpr std::size_t kMaxDecoded = 2048;
+  std::vector<std::pair<const FrameIndex*, std::uint32_t>> outer;
+  for (const auto& index : frames) {
+    for (std::uint32_t i = 0; i < index->bricks.size(); ++i) {
+      const glm::uvec3 c = index->bricks[i].coord;
+      if (glm::any(glm::equal(c, lo)) || glm::any(glm::equal(c, hi))) outer.emplace_back(index.get(), i);
+    }
+  }
+  const glm::dvec3 lower(lo * h.brickSize), upper((hi + 1u) * h.brickSize);
+  if (outer.size() > kMaxDecoded) return Box{h.origin + lower * h.cellSize, h.origin + upper * h.cellSize};
+  glm::dvec3 cellMin(std::numeric_limits<double>::infinity()), cellMax(-std::numeric_limits<double>::infinity());
+  for (const auto& [index, i] : outer) {
+    const auto brick = source.read(BrickKey{index->frame, index->bricks[i].coord});
+    FLIPSCOPE_CHECK(brick, "brick " << i << " of frame " << index->frame << " listed but empty");
+    const glm::dvec3 base(index->bricks[i].coord * h.brickSize);
+    for (std::uint32_t cell : brick->cells) {
+      const glm::dvec3 c =
+          base + glm::dvec3(cell % h.brickSize, cell / h.brickSize % h.brickSize, cell / (h.brickSize * h.brickSize));
+      cellMin = glm::min(cellMin, c);
+      cellMax = glm::max(cellMax, c + 1.0);
+    }
+  }
+  return Box{h.origin + cellMin * h.cellSize, h.origin + cellMax * h.cellSize};
 }
 
 }  // namespace flipscope

@@ -17,6 +17,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "core/Box.h"
 #include "preprocess/store/BrickStore.h"
 
 namespace flipscope {
@@ -89,5 +90,10 @@ class StoreBrickSource : public BrickSource {
  private:
   BrickStore mStore;
 };
+
+/// World box of the occupied cells of frames [first, last] of `source` (empty box when they hold
+/// no brick). Cell-exact from the bricks on the outer layers, or brick-exact when more than a
+/// few thousand bricks form them across the range. What a default camera frames.
+Box occupiedBounds(BrickSource& source, int first, int last);
 
 }  // namespace flipscope

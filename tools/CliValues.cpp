@@ -2,8 +2,8 @@
 
 #include <charconv>
 #include <cmath>
-#include <string_view>
 #include <cstdio>
+#include <string_view>
 #include <sstream>
 #include <vector>
 
@@ -121,6 +121,26 @@ std::string describeAttribute(const StoreHeader& header) {
       return header.attributeName + " (the length of a vector)";
   }
   return header.attributeName;
+}
+
+glm::dvec3 parseUpAxis(const std::string& option, const std::string& text) {
+  if (text == "x") return {1, 0, 0};
+  if (text == "y") return {0, 1, 0};
+  if (text == "z") return {0, 0, 1};
+  throw InputError(option + ": expected x, y or z, got '" + text + "'");
+}
+
+std::string formatNumber17(double value) {
+  char text[40];
+  std::snprintf(text, sizeof text, "%.17g", value);
+  return text;
+}
+
+std::string formatBox(const Box& box) {
+  std::string text;
+  for (double v : {box.min.x, box.min.y, box.min.z, box.max.x, box.max.y, box.max.z})
+    text += (text.empty() ? "" : ",") + formatNumber17(v);
+  return text;
 }
 
 }  // namespace flipscope::tools

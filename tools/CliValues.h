@@ -22,6 +22,12 @@ Box parseBox(const std::string& option, const std::string& text);
 std::pair<std::uint32_t, std::uint32_t> parseImageSize(const std::string& option, const std::string& text);
 /// "auto", "gpu" or "cpu" (the `--device` of render, demo and bench render).
 DeviceChoice parseDeviceChoice(const std::string& option, const std::string& text);
+/// "x", "y" or "z" -> the unit axis (the `--up` of a default camera).
+glm::dvec3 parseUpAxis(const std::string& option, const std::string& text);
+/// A box as parseBox reads it, every number with 17 significant digits (read back exactly).
+std::string formatBox(const Box& box);
+/// A number with 17 significant digits (read back exactly).
+std::string formatNumber17(double value);
 /// "none", "speed (the length of the velocity)", "pscale (scalar)", "v (the length of a vector)".
 std::string describeAttribute(const StoreHeader& header);
 

@@ -81,13 +81,6 @@ glm::vec2 parseColorRange(const std::string& text) {
   return {values[0], values[1]};
 }
 
-glm::dvec3 parseUp(const std::string& text) {
-  if (text == "x") return {1, 0, 0};
-  if (text == "y") return {0, 1, 0};
-  if (text == "z") return {0, 0, 1};
-  throw InputError("--up: expected x, y or z, got '" + text + "'");
-}
-
 void runRender(const RenderArgs& a) {
   RenderJob job;
   job.store = a.store;
@@ -131,7 +124,7 @@ void runRender(const RenderArgs& a) {
   validate(job.settings);
   if (!a.camera.empty()) job.camera = parseCamera("--camera", a.camera);
   if (!a.cameraFile.empty()) job.camera = loadCamera(a.cameraFile);
-  job.up = parseUp(a.up);
+  job.up = parseUpAxis("--up", a.up);
   job.device = parseDeviceChoice("--device", a.device);
   job.quiet = a.quiet;
   const auto files = runRenderJob(job);

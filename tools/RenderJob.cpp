@@ -25,6 +25,17 @@ std::string outputPathForFrame(const std::string& pattern, int frame) {
   return out;
 }
 
+Camera defaultRenderCamera(BrickSource& source, int first, int last, std::uint32_t width, std::uint32_t height,
+                           glm::dvec3 up) {
+  Box bounds = occupiedBounds(source, first, last);
+  if (bounds.isEmpty()) bounds = Box{source.header().origin, source.header().domainMax()};
+  try {
+    return frameOnBox(bounds, double(width) / height, up);
+  } catch (const InputError& e) {
+    throw FileError(source.name(), e.what());
+  }
+}
+
 std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
   BrickStore store = BrickStore::open(job.store);
   const std::vector<int> stored = store.frames();
@@ -83,13 +94,7 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
   if (job.camera) {
     camera = *job.camera;
   } else {
-    Box bounds = renderer.occupiedBounds(first, last);  // all frames: a flipbook keeps one camera
-    if (bounds.isEmpty()) bounds = Box{store.header().origin, store.header().domainMax()};
-    try {
-      camera = frameOnBox(bounds, double(settings.width) / settings.height, job.up);
-    } catch (const InputError& e) {
-      throw FileError(job.store, e.what());
-    }
+    camera = defaultRenderCamera(renderer.source(), first, last, settings.width, settings.height, job.up);
   }
 
   std::vector<RenderedFile> files;

@@ -43,6 +43,12 @@ struct RenderedFile {
 /// frame unless quiet.
 std::vector<RenderedFile> runRenderJob(const RenderJob& job);
 
+/// The camera a render job frames when none is given: frameOnBox over the occupied cells of
+/// every frame of [first, last] (one camera for the whole flipbook), or over the domain when
+/// they hold no brick. Throws FileError naming the source when no camera can frame it.
+Camera defaultRenderCamera(BrickSource& source, int first, int last, std::uint32_t width, std::uint32_t height,
+                           glm::dvec3 up);
+
 /// `pattern` with each run of '#' replaced by `frame`, zero-padded to the run's length.
 std::string outputPathForFrame(const std::string& pattern, int frame);
 
