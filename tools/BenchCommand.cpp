@@ -11,6 +11,7 @@ void addBenchCommand(CLI::App& app) {
   addBenchStreamingCommand(*bench);
   addBenchRenderCommand(*bench);
   addBenchSurfaceCommand(*bench);
+  addBenchFarmCommand(*bench);
 }
 
 }  // namespace flipscope::tools

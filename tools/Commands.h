@@ -39,5 +39,6 @@ void addBenchPreprocessCommand(CLI::App& bench);
 void addBenchStreamingCommand(CLI::App& bench);
 void addBenchRenderCommand(CLI::App& bench);
 void addBenchSurfaceCommand(CLI::App& bench);
+void addBenchFarmCommand(CLI::App& bench);
 
 }  // namespace flipscope::tools

@@ -4,7 +4,8 @@
 # SLURM_CONF pointing at it (and FLIPSCOPE_SLURM=1); then stops exactly the daemons it started,
 # by the PIDs they wrote, and removes the directory. Exits with COMMAND's status.
 # CI: tests/farm/run-slurm.sh ctest --test-dir build -L slurm --output-on-failure
-# Debian: slurm-wlm munge (.ci/install-deps).
+# Debian: slurm-wlm munge (.ci/install-deps). The controller schedules on every event
+# (batch_sched_delay=0): with the default delay of 3 s each short task would wait that long.
 set -eu
 [ "$#" -gt 0 ] || { echo "usage: $0 COMMAND..." >&2; exit 2; }
 for tool in munged slurmctld slurmd sbatch sinfo; do
@@ -65,6 +66,7 @@ SelectTypeParameters=CR_Core
 MpiDefault=none
 ReturnToService=2
 SchedulerType=sched/backfill
+SchedulerParameters=batch_sched_delay=0,sched_min_interval=0
 AccountingStorageType=accounting_storage/none
 JobAcctGatherType=jobacct_gather/none
 JobCompType=jobcomp/none
