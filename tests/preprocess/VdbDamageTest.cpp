@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "DamageTestSupport.h"
 #include "ParticleTestSupport.h"
 #include "VdbTestFiles.h"
 #include "preprocess/particles/ParticleFormatRegistry.h"
@@ -67,7 +68,7 @@ struct Sweep {
 /// Every `step`-th byte, changed three ways (low bit, high bit, all bits flipped).
 Sweep mutateBytes(const std::string& name, const std::string& original, std::size_t step) {
   Sweep sweep;
-  for (std::size_t at = 0; at < original.size(); at += step)
+  for (std::size_t at = 0; at < original.size(); at += step * testing::damageSweepStride())
     for (unsigned flip : {0x01u, 0x80u, 0xffu}) {
       std::string damaged = original;
       damaged[at] = char(static_cast<unsigned char>(damaged[at]) ^ flip);
@@ -81,7 +82,7 @@ Sweep mutateBytes(const std::string& name, const std::string& original, std::siz
 
 /// Every proper prefix (every `step`-th length) must be refused: nothing reads as complete.
 void truncateEverywhere(const std::string& name, const std::string& original, std::size_t step) {
-  for (std::size_t length = 0; length < original.size(); length += step) {
+  for (std::size_t length = 0; length < original.size(); length += step * testing::damageSweepStride()) {
     const Outcome outcome = readDamaged(name, original.substr(0, length), name + " cut to " + std::to_string(length));
     ASSERT_TRUE(outcome.refused) << name << " cut to " << length << " bytes of " << original.size() << " was accepted";
   }
