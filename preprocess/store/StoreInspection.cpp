@@ -32,7 +32,8 @@ double spacingInCells(const StoreHeader& header) {
 }
 
 std::string incompleteStoreReason() {
-  return "incomplete store: no frames (an interrupted or failed convert left it); convert again";
+  return "incomplete store: no frames yet (a convert is adding them, or one was interrupted or failed: then convert "
+         "again)";
 }
 
 std::vector<std::string> checkFrameTable(const BrickStore& store) {

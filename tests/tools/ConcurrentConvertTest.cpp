@@ -71,7 +71,13 @@ TEST_F(ConcurrentConvert, InterleavedFramesIntoAPreparedStoreAreAllThereAndIntac
     for (int f = 1; f <= kFrames; ++f)
       commands.push_back("convert " + path("in_####.bin") + " --frames " + std::to_string(f) + " -o " + store +
                          " --append -q");
-    for (int code : runTogether(commands)) EXPECT_EQ(code, 0);
+    // Readers beside the writers see only complete frames: intact ones, or none yet, never a
+    // damaged or missing one (`info --verify` would name it "damaged").
+    for (int r = 0; r < 3; ++r)
+      commands.push_back("info --verify " + store +
+                         " 2>&1 | grep -v 'incomplete store' | grep -q '^damaged:' && exit 9 || exit 0");
+    const std::vector<int> codes = runTogether(commands);
+    for (int code : codes) EXPECT_EQ(code, 0);
     CommandRun verify = runFlipscope("info --verify " + store);
     EXPECT_EQ(verify.exitCode, 0) << verify.output;
     flipscope::testing::expectSameFrames(path("serial"), store);
