@@ -180,7 +180,15 @@ AtomicFile::AtomicFile(std::filesystem::path destination) : mDestination(std::mo
   const DeferCleanupSignals step;          // registered and created as one step
   mCleanup = CleanupOnSignal(mTemporary);
   mFile = std::fopen(mTemporary.c_str(), "wb");
-  if (!mFile) throw OutputError(mTemporary, "cannot create temporary file: " + errnoText());
+  if (!mFile) {
+    // Name what the user asked for, and the directory when it is what is missing.
+    const std::string reason = errnoText();
+    std::error_code ec;
+    if (!std::filesystem::is_directory(dir, ec))
+      throw OutputError(mDestination, "cannot be written: the directory " + dir.string() + " does not exist");
+    throw OutputError(mDestination, "cannot be written (its temporary " + mTemporary.filename().string() +
+                                        " cannot be created: " + reason + ")");
+  }
   std::setvbuf(mFile, nullptr, _IOFBF, 1 << 20);
 }
 

@@ -113,6 +113,7 @@ struct ConvertFarmArgs {
   std::string attribute;
   std::vector<std::string> grids;
   int zstdLevel = 1;
+  std::string scratch;
 };
 
 /// --mem of each task's convert: 85 % of the task's memory, the rest for the process itself.
@@ -166,6 +167,7 @@ void runFarmConvert(const ConvertFarmArgs& a) {
     if (a.brickSize > 0) prepareOnly("--brick-size", std::to_string(a.brickSize));
     if (!a.attribute.empty()) prepareOnly("--attribute", a.attribute);
     plan.convertArgs.insert(plan.convertArgs.end(), {"--zstd-level", std::to_string(a.zstdLevel)});
+    if (!a.scratch.empty()) plan.convertArgs.insert(plan.convertArgs.end(), {"--scratch", a.scratch});
     todo = plan.frames;
   }
   auto scheduler = farm::makeSlurmScheduler();
@@ -304,6 +306,9 @@ void addFarmCommand(CLI::App& app) {
   c->add_option("--attribute", convert->attribute, "Per-particle attribute to store, as for convert");
   c->add_option("--grid", convert->grids, "VDB: PointDataGrid names to read");
   c->add_option("--zstd-level", convert->zstdLevel, "zstd level of brick payloads")->check(CLI::Range(-5, 19));
+  c->add_option("--scratch", convert->scratch,
+                "Spill directory of each task's out-of-core convert, on the node's own disk, e.g. /tmp (default: "
+                "the store)");
   c->callback([convert] { runFarmConvert(*convert); });
 
   auto render = std::make_shared<RenderFarmArgs>();

@@ -3,6 +3,7 @@
 #include <map>
 
 #include "core/AtomicFile.h"
+#include "core/Error.h"
 #include "tools/farm/RunProgram.h"
 
 namespace flipscope::farm {
@@ -144,7 +145,15 @@ std::vector<FarmSubmission> submitJobs(std::vector<FarmJob>& jobs, const FarmPla
     writeFileAtomically(job.request.script, std::as_bytes(std::span(job.script.data(), job.script.size())));
     std::filesystem::permissions(job.request.script, std::filesystem::perms::owner_exec,
                                  std::filesystem::perm_options::add);
-    ids[job.role] = scheduler.submit(job.request);
+    try {
+      ids[job.role] = scheduler.submit(job.request);
+    } catch (const InputError& e) {
+      if (submitted.empty()) throw;
+      std::string before;
+      for (const auto& s : submitted) before += " " + s.job;
+      throw InputError(std::string(e.what()) + "; the " + scheduler.name() +
+                       " jobs submitted before it are queued and should be cancelled:" + before);
+    }
     submitted.push_back({job.role, ids[job.role], job.tasks});
     appendSubmissions(farm, {submitted.back()});  // recorded at once: a later failure keeps it
   }

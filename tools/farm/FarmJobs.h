@@ -33,7 +33,8 @@ std::vector<FarmJob> planJobs(const FarmPlan& plan, const std::vector<int>& fram
                               const Scheduler& scheduler);
 
 /// Writes each job's script into the farm directory and submits them in order, dependencies
-/// resolved to the job ids before them; records the submissions in jobs.json.
+/// resolved to the job ids before them; records the submissions in jobs.json. A refused
+/// submission throws InputError naming the jobs already queued.
 std::vector<FarmSubmission> submitJobs(std::vector<FarmJob>& jobs, const FarmPlan& plan, Scheduler& scheduler);
 
 /// What --dry-run prints: every script, each after the command that would submit it.
