@@ -125,12 +125,12 @@ void runBenchFarm(const BenchFarmArgs& a) {
   const double cacheParticles = 300 * 500e6, cacheBytes = cacheParticles * 12;
   const double nodeRate = std::min(total / serial, readRate / 12);
   std::printf("\nOn paper: 300 frames x 500 M particles (%.1f TB raw), a node at %s particles/s (this run's serial "
-              "convert, capped by its disk),\nthe farm's reads capped at %.2f GB/s (--shared-read)\n",
+              "convert, capped by its disk),\nthe farm's reads (each frame twice: bounds pass, convert) capped at %.2f GB/s (--shared-read)\n",
               cacheBytes / 1e12, Progress::humanCount(nodeRate).c_str(), a.sharedRead);
   std::printf("%-10s %14s %14s\n", "nodes", "minutes", "bound by");
   for (int n : {1, 4, 16, 64, 256}) {
     const double compute = cacheParticles / (nodeRate * n);
-    const double network = cacheBytes / (a.sharedRead * 1e9);
+    const double network = 2 * cacheBytes / (a.sharedRead * 1e9);  // the bounds pass, then convert
     const double seconds = std::max(compute, network) + 300.0 / n * empty * std::min(cpus, a.emptyTasks) / a.emptyTasks;
     std::printf("%-10d %14.1f %14s\n", n, seconds / 60, compute >= network ? "conversion" : "network");
   }
