@@ -490,7 +490,10 @@ class StoreDirectory {
     // No store left (a failed first convert) and no other writer: the lock file goes too, and
     // the directory when this convert created it.
     std::error_code ec;
-    if (!BrickStore::exists(mDir)) mLock->removeFileIfAlone();
+    try {
+      if (!BrickStore::exists(mDir)) mLock->removeFileIfAlone();
+    } catch (const std::exception&) {  // the lock file stays; it is harmless
+    }
     if (mCreated && std::filesystem::is_empty(mDir, ec)) std::filesystem::remove(mDir, ec);
   }
   StoreDirectory(const StoreDirectory&) = delete;
@@ -498,6 +501,10 @@ class StoreDirectory {
 
   /// No other convert writes this store: this one may remove what dead writers left.
   bool alone() const { return mLock->alone(); }
+  /// The filesystem supports the store's locks (StoreLock.h).
+  bool locking() const { return mLock->locking(); }
+  /// This convert made the directory.
+  bool created() const { return mCreated; }
   /// Housekeeping done: other writers may join.
   void share() { mLock->share(); }
   /// The store has a frame (or a header to keep): the lock file stays with it.
@@ -511,17 +518,24 @@ class StoreDirectory {
   bool mCreated = false;
 };
 
-/// store.fsh of a store that has no frame yet: removed again when the convert fails (an
-/// exception) or is stopped by SIGINT/SIGTERM/SIGHUP before its first frame, so that a failed
-/// convert never leaves a store of only store.fsh. SIGKILL leaves it: that store has no frames
-/// and reports itself incomplete.
+/// store.fsh of a store that this convert created and that has no frame yet: removed again when
+/// the convert fails (an exception) before its first frame, unless another writer listed one
+/// meanwhile (BrickStore::removeIfFrameless), so that a failed convert never leaves a store of
+/// only store.fsh. SIGINT, SIGTERM and SIGHUP remove it too, as long as this convert created the
+/// store directory (no other writer can have joined a store that did not exist); SIGKILL leaves
+/// it: that store has no frames and reports itself incomplete.
 class FramelessHeader {
  public:
-  explicit FramelessHeader(const std::filesystem::path& file) : mFile(file), mCleanup(file) {}
+  FramelessHeader(const std::filesystem::path& dir, const StoreId& id, bool createdDirectory)
+      : mDir(dir), mId(id) {
+    if (createdDirectory) mCleanup = CleanupOnSignal(dir / kStoreHeaderName);
+  }
   ~FramelessHeader() {
     if (!mArmed) return;
-    std::error_code ec;
-    std::filesystem::remove(mFile, ec);
+    try {
+      BrickStore::removeIfFrameless(mDir, mId);
+    } catch (const std::exception&) {  // a damaged store.fsh: leave it for `info` to name
+    }
   }
   FramelessHeader(const FramelessHeader&) = delete;
   FramelessHeader& operator=(const FramelessHeader&) = delete;
@@ -532,7 +546,8 @@ class FramelessHeader {
   }
 
  private:
-  std::filesystem::path mFile;
+  std::filesystem::path mDir;
+  StoreId mId;
   CleanupOnSignal mCleanup;
   bool mArmed = true;
 };
@@ -750,6 +765,12 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
     noteStaleFiles(removeStaleFiles(options.scratchDir, false), options.scratchDir.string(), report);
   StoreHeader header;
   bool keepHeader = false;
+  if (options.append && !directory.locking())
+    throw FileError(storeDir, std::string("--append: the filesystem does not support file locks, so concurrent "
+                                          "converts into this store would be unsafe (NFS: mount without nolock)"));
+  if (!directory.locking())
+    report.warnings.push_back(storeDir.string() + ": the filesystem does not support file locks; do not run another "
+                                                  "convert into this store at the same time");
   if (options.append && !BrickStore::exists(storeDir))
     throw FileError(storeDir, std::string("--append: not a brick store (no ") + kStoreHeaderName +
                                   "); make it with a first convert, or convert --prepare");
@@ -824,9 +845,10 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
   std::optional<FramelessHeader> framelessHeader;
   std::optional<BrickStore> created;
   {
-    const DeferCleanupSignals step;  // store.fsh registered and written as one step
-    if (!keepHeader) framelessHeader.emplace(storeDir / kStoreHeaderName);
-    created = BrickStore::createOrAppend(storeDir, header, BrickStore::FramelessStore::Join);
+    const DeferCleanupSignals step;  // store.fsh written and registered as one step
+    bool wrote = false;
+    created = BrickStore::createOrAppend(storeDir, header, BrickStore::FramelessStore::Join, &wrote);
+    if (wrote) framelessHeader.emplace(storeDir, created->header().id, directory.created());
   }
   BrickStore& store = *created;
   report.header = store.header();

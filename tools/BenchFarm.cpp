@@ -5,7 +5,6 @@
 // particle cache would take on farms of N nodes.
 #include <CLI/CLI.hpp>
 
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -17,6 +16,7 @@
 
 #include "core/Error.h"
 #include "core/Progress.h"
+#include "tools/BenchDisk.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
 #include "tools/farm/RunProgram.h"
@@ -48,23 +48,6 @@ double timed(const std::vector<std::string>& args) {
   return seconds;
 }
 
-/// Reads `files` with their pages dropped from the cache first: bytes per second from disk.
-double uncachedReadRate(const std::vector<fs::path>& files) {
-  std::uint64_t bytes = 0;
-  std::vector<char> buffer(16 << 20);
-  const auto start = std::chrono::steady_clock::now();
-  for (const auto& file : files) {
-    const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) continue;
-    ::fdatasync(fd);
-    ::posix_fadvise(fd, 0, 0, POSIX_FADV_DONTNEED);
-    for (ssize_t n; (n = ::read(fd, buffer.data(), buffer.size())) > 0;) bytes += std::uint64_t(n);
-    ::close(fd);
-  }
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return seconds > 0 ? double(bytes) / seconds : 0;
-}
-
 /// An array of `tasks` empty tasks through sbatch, waited for: seconds from submission to end.
 double emptyArray(int tasks, const fs::path& dir) {
   const fs::path script = dir / "empty.sh";
@@ -94,7 +77,7 @@ void runBenchFarm(const BenchFarmArgs& a) {
   std::vector<fs::path> files;
   for (const auto& e : fs::directory_iterator(work / "in")) files.push_back(e.path());
   std::sort(files.begin(), files.end());
-  const double readRate = uncachedReadRate(files);
+  const double readRate = readUncached(files).bytesPerSecond();
 
   fs::remove_all(work / "serial");
   fs::remove_all(work / "farm");

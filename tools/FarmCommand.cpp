@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <thread>
 
 #include "core/Error.h"
@@ -31,7 +32,7 @@ using farm::FarmPlan;
 
 /// What farm convert and farm render share: where the tasks run, how, and how to submit.
 struct FarmArgs {
-  int chunk = 1;
+  int chunk = 0;  ///< 0: not given (1 for a new plan, the plan's on --resume)
   farm::FarmResources resources;
   std::string frames;
   std::string flipscope;
@@ -42,7 +43,8 @@ struct FarmArgs {
 
 void addFarmOptions(CLI::App* cmd, FarmArgs& a) {
   cmd->add_option("--frames", a.frames, "Frame range A-B (default: every frame)");
-  cmd->add_option("--chunk", a.chunk, "Frames per array task")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("--chunk", a.chunk, "Frames per array task (default 1; on --resume, the plan's)")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--partition", a.resources.partition, "Scheduler partition (queue) of every task");
   cmd->add_option("--time", a.resources.time, "Wall-time limit of every task, e.g. 2:00:00");
   cmd->add_option("--cpus", a.resources.cpus, "CPUs of every task")->check(CLI::PositiveNumber);
@@ -53,6 +55,12 @@ void addFarmOptions(CLI::App* cmd, FarmArgs& a) {
   cmd->add_flag("--wait", a.wait, "Wait for the final task, print its summary, exit 1 when frames are missing");
 }
 
+/// The task memory as Slurm reads --mem: a number without a unit is MiB (K, M, G, T suffixes).
+std::string slurmMemory(const std::string& text) {
+  if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos) return text;
+  return text + "M";
+}
+
 fs::path thisBinary() {
   std::error_code ec;
   const fs::path self = fs::read_symlink("/proc/self/exe", ec);
@@ -60,11 +68,44 @@ fs::path thisBinary() {
   return self;
 }
 
+/// The options of `a` into the plan: all of them for a new plan; on --resume only those given,
+/// over the plan's.
 void fillCommon(FarmPlan& plan, const FarmArgs& a) {
-  plan.chunk = a.chunk;
-  plan.resources = a.resources;
-  plan.flipscope = a.flipscope.empty() ? thisBinary() : fs::absolute(a.flipscope);
+  const bool fresh = !a.resume;
+  if (a.chunk > 0 || fresh) plan.chunk = a.chunk > 0 ? a.chunk : 1;
+  if (!a.resources.partition.empty() || fresh) plan.resources.partition = a.resources.partition;
+  if (!a.resources.time.empty() || fresh) plan.resources.time = a.resources.time;
+  if (a.resources.cpus > 0 || fresh) plan.resources.cpus = a.resources.cpus;
+  if (!a.resources.memory.empty() || fresh) plan.resources.memory = slurmMemory(a.resources.memory);
+  if (!a.flipscope.empty() || fresh) plan.flipscope = a.flipscope.empty() ? thisBinary() : fs::absolute(a.flipscope);
   if (!fs::exists(plan.flipscope)) throw FileError(plan.flipscope, "--flipscope: no such binary");
+}
+
+/// A resume while tasks of the earlier submissions still run would have two writers of a frame:
+/// refused, naming them.
+void refuseWhileRunning(const FarmPlan& plan) {
+  auto scheduler = farm::makeSlurmScheduler();
+  std::string running;
+  for (const auto& s : farm::loadSubmissions(farm::farmDirectory(plan.store, plan.kind)))
+    if (!scheduler->ended(s.job)) running += " " + s.job;
+  if (!running.empty())
+    throw InputError("farm " + std::string(farm::farmKindName(plan.kind)) + " --resume: jobs of " +
+                     plan.store.string() + " are still queued or running:" + running +
+                     "; wait for them (farm status) or cancel them first");
+}
+
+/// Before a submission: the summary and the failure logs of the frames about to run again go,
+/// so that neither describes the last run.
+void clearLastRun(const FarmPlan& plan, const std::vector<int>& frames) {
+  const fs::path farmDir = farm::farmDirectory(plan.store, plan.kind);
+  std::error_code ec;
+  fs::remove(farmDir / "summary.txt", ec);
+  fs::remove(farmDir / "summary.json", ec);
+  for (int f : frames) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame_%06d.log", f);
+    fs::remove(farmDir / "failed" / name, ec);
+  }
 }
 
 /// Submits (or, with --dry-run, prints) `jobs`, then reports how to follow them; with --wait,
@@ -76,6 +117,10 @@ void launch(std::vector<farm::FarmJob>& jobs, const FarmPlan& plan, const FarmAr
     std::printf("farm %s: dry run, nothing submitted (%zu jobs)\n", farm::farmKindName(plan.kind), jobs.size());
     return;
   }
+  std::vector<int> frames;
+  for (const auto& job : jobs)
+    for (const auto& task : job.tasks) frames.insert(frames.end(), task.begin(), task.end());
+  clearLastRun(plan, frames);
   const auto submitted = farm::submitJobs(jobs, plan, *scheduler);
   std::string ids;
   for (const auto& s : submitted) {
@@ -88,11 +133,14 @@ void launch(std::vector<farm::FarmJob>& jobs, const FarmPlan& plan, const FarmAr
               plan.store.c_str(), ids.c_str(), (farmDir / "logs").c_str(), (farmDir / "summary.txt").c_str());
   if (!a.wait) return;
   const std::string last = submitted.back().job;
-  while (!scheduler->ended(last)) std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  // Polled gently: every second at first, then every 5 s.
+  for (int polls = 0; !scheduler->ended(last); ++polls)
+    std::this_thread::sleep_for(std::chrono::milliseconds(polls < 30 ? 1000 : 5000));
   const std::string summary = readSummaryText(plan);
   std::printf("%s", summary.c_str());
-  if (summary.empty()) throw CommandFailed("farm: the final task wrote no summary; see " + (farmDir / "logs").string());
-  if (summary.find(", complete") == std::string::npos) throw CommandFailed("farm: frames are missing");
+  const std::optional<bool> complete = summaryComplete(plan);
+  if (!complete) throw CommandFailed("farm: the final task wrote no summary; see " + (farmDir / "logs").string());
+  if (!*complete) throw CommandFailed("farm: frames are missing");
 }
 
 std::optional<FrameRange> frameRange(const std::string& text) {
@@ -117,6 +165,7 @@ struct ConvertFarmArgs {
 };
 
 /// --mem of each task's convert: 85 % of the task's memory, the rest for the process itself.
+/// `taskMemory` as Slurm reads it (slurmMemory).
 std::string convertBudget(const std::string& taskMemory) {
   const std::uint64_t bytes = parseBytes("--mem", taskMemory);
   return std::to_string(std::max<std::uint64_t>(bytes / 100 * 85 >> 20, 16)) + "M";
@@ -132,6 +181,7 @@ void runFarmConvert(const ConvertFarmArgs& a) {
     plan = farm::loadPlan(store, FarmKind::Convert);
     if (!a.inputs.empty()) throw InputError("farm convert --resume: the inputs come from the plan; give none");
     fillCommon(plan, a.farm);
+    if (!a.farm.dryRun) refuseWhileRunning(plan);
     prepare = !BrickStore::exists(store);  // the prepare job failed: write the header this time
     todo = framesNotDone(plan);
     if (todo.empty()) {
@@ -158,7 +208,7 @@ void runFarmConvert(const ConvertFarmArgs& a) {
     };
     if (!a.domain.empty()) both("--domain", formatBox(parseBox("--domain", a.domain)));  // also clips, as convert does
     for (const auto& grid : a.grids) both("--grid", grid);
-    if (!a.farm.resources.memory.empty()) both("--mem", convertBudget(a.farm.resources.memory));
+    if (!plan.resources.memory.empty()) both("--mem", convertBudget(plan.resources.memory));
     auto prepareOnly = [&](const std::string& option, const std::string& value) {
       plan.prepareArgs.insert(plan.prepareArgs.end(), {option, value});
     };
@@ -198,6 +248,7 @@ void runFarmRender(const RenderFarmArgs& a, const std::vector<std::string>& extr
   if (a.farm.resume) {
     plan = farm::loadPlan(store, FarmKind::Render);
     fillCommon(plan, a.farm);
+    if (!a.farm.dryRun) refuseWhileRunning(plan);
     todo = framesNotDone(plan);
     if (todo.empty()) {
       std::printf("farm render --resume: all %zu frames of %s are rendered\n", plan.frames.size(), store.c_str());

@@ -1,5 +1,7 @@
 #include "tools/FarmCommon.h"
 
+#include <nlohmann/json.hpp>
+
 #include <fstream>
 #include <memory>
 #include <sstream>
@@ -53,6 +55,16 @@ std::string readSummaryText(const farm::FarmPlan& plan) {
   std::stringstream text;
   text << in.rdbuf();
   return text.str();
+}
+
+std::optional<bool> summaryComplete(const farm::FarmPlan& plan) {
+  std::ifstream in(farm::farmDirectory(plan.store, plan.kind) / "summary.json");
+  if (!in) return std::nullopt;
+  try {
+    return nlohmann::json::parse(in).at("complete").get<bool>();
+  } catch (const nlohmann::json::exception&) {
+    return std::nullopt;
+  }
 }
 
 }  // namespace flipscope::tools

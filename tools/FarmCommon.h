@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,9 @@ std::vector<int> framesNotDone(const farm::FarmPlan& plan);
 
 /// summary.txt of the plan's farm directory; "" when the final task has not written it.
 std::string readSummaryText(const farm::FarmPlan& plan);
+
+/// summary.json's "complete"; nullopt when there is no (readable) summary.
+std::optional<bool> summaryComplete(const farm::FarmPlan& plan);
 
 /// `farm bounds` and `farm finalize`: the commands the farm's jobs run.
 void addFarmTaskCommands(CLI::App& farm);

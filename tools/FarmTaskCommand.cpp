@@ -89,6 +89,8 @@ std::pair<Box, int> reduceBounds(const farm::FarmPlan& plan) {
   if (domain.isEmpty())
     throw InputError(plan.store.string() +
                      ": no finite particle positions in any frame: cannot derive a domain (give --domain)");
+  if (!first)
+    throw FileError(boundsFile(plan, 0).parent_path(), "the bounds files list every frame as failed, yet not empty");
   return {domain, *first};
 }
 

@@ -495,7 +495,8 @@ BrickStore BrickStore::open(const std::filesystem::path& dir) {
 }
 
 BrickStore BrickStore::createOrAppend(const std::filesystem::path& dir, const StoreHeader& header,
-                                      FramelessStore frameless) {
+                                      FramelessStore frameless, bool* wrote) {
+  if (wrote) *wrote = false;
   std::error_code created;
   std::filesystem::create_directories(dir, created);
   if (created) throw OutputError(dir, "cannot create the store directory: " + created.message());
@@ -517,7 +518,19 @@ BrickStore BrickStore::createOrAppend(const std::filesystem::path& dir, const St
   fresh.version = kStoreVersion;
   if (fresh.id == StoreId{}) fresh.id = randomStoreId();
   writeFileAtomically(dir / kStoreHeaderName, serializeStoreHeader(fresh));
+  if (wrote) *wrote = true;
   return open(dir);
+}
+
+bool BrickStore::removeIfFrameless(const std::filesystem::path& dir, const StoreId& id) {
+  const StoreTableLock table(dir);
+  const auto headerPath = dir / kStoreHeaderName;
+  std::error_code ec;
+  if (!std::filesystem::exists(headerPath, ec)) return false;
+  std::vector<int> frames;
+  const StoreHeader now = parseStoreHeader(readFile(headerPath), headerPath, &frames);
+  if (now.id != id || !frames.empty()) return false;  // another store now, or frames listed
+  return std::filesystem::remove(headerPath, ec);
 }
 
 std::vector<int> BrickStore::frames() const {

@@ -163,8 +163,13 @@ class BrickStore {
   /// zero), or, if a store with frames exists (or one without, to join), checks that its header
   /// matches (same brick size, cell size, origin, grid, attribute) and opens it for appending.
   /// Under the table lock (StoreLock.h), so concurrent writers agree on one store.
+  /// `created`, when given, says whether this call wrote store.fsh.
   static BrickStore createOrAppend(const std::filesystem::path& dir, const StoreHeader& header,
-                                   FramelessStore frameless = FramelessStore::Replace);
+                                   FramelessStore frameless = FramelessStore::Replace, bool* created = nullptr);
+  /// Removes store.fsh of the store `id` while it lists no frame (under the table lock): what a
+  /// writer whose first frame failed does with the header it made. False when another writer
+  /// listed a frame meanwhile, or the header is another store's.
+  static bool removeIfFrameless(const std::filesystem::path& dir, const StoreId& id);
   static bool exists(const std::filesystem::path& dir);
 
   const std::filesystem::path& directory() const { return mDir; }

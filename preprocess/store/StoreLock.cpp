@@ -1,6 +1,7 @@
 #include "preprocess/store/StoreLock.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -14,15 +15,16 @@ namespace {
 constexpr off_t kWriterByte = 0;
 constexpr off_t kTableByte = 1;
 
+enum class LockResult { Taken, Busy, Unsupported };
+
 int openLockFile(const std::filesystem::path& file) {
   const int fd = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   if (fd < 0) throw OutputError(file, std::string("cannot open the store's lock file: ") + std::strerror(errno));
   return fd;
 }
 
-/// fcntl(F_OFD_SETLK[W]) on one byte; false when it is held by another (non-blocking only).
-/// Filesystems without locks count as success: there is nothing to wait for.
-bool lockByte(int fd, off_t byte, short type, bool wait, const std::filesystem::path& file) {
+/// fcntl(F_OFD_SETLK[W]) on one byte.
+LockResult lockByte(int fd, off_t byte, short type, bool wait, const std::filesystem::path& file) {
   struct flock lock {};
   lock.l_type = type;
   lock.l_whence = SEEK_SET;
@@ -30,24 +32,38 @@ bool lockByte(int fd, off_t byte, short type, bool wait, const std::filesystem::
   lock.l_len = 1;
   while (::fcntl(fd, wait ? F_OFD_SETLKW : F_OFD_SETLK, &lock) != 0) {
     if (errno == EINTR) continue;
-    if (errno == EAGAIN || errno == EACCES) return false;
-    if (errno == ENOLCK || errno == EOPNOTSUPP || errno == EINVAL || errno == ENOSYS) return true;
+    if (errno == EAGAIN || errno == EACCES) return LockResult::Busy;
+    if (errno == ENOLCK || errno == EOPNOTSUPP || errno == EINVAL || errno == ENOSYS) return LockResult::Unsupported;
     throw FileError(file, std::string("cannot lock: ") + std::strerror(errno));
   }
-  return true;
+  return LockResult::Taken;
+}
+
+/// Whether `fd` is still the file at `file`: a lock taken on a lock file that a writer unlinked
+/// meanwhile (removeFileIfAlone) would lock nothing others see.
+bool stillThere(int fd, const std::filesystem::path& file) {
+  struct stat open {}, named {};
+  if (::fstat(fd, &open) != 0 || ::stat(file.c_str(), &named) != 0) return false;
+  return open.st_dev == named.st_dev && open.st_ino == named.st_ino && open.st_nlink > 0;
 }
 
 }  // namespace
 
-StoreWriterLock::StoreWriterLock(const std::filesystem::path& storeDir)
-    : mFile(storeDir / kStoreLockName), mFd(openLockFile(mFile)) {
-  try {
-    mAlone = lockByte(mFd, kWriterByte, F_WRLCK, false, mFile);
-    mExclusive = mAlone;
-    if (!mAlone) lockByte(mFd, kWriterByte, F_RDLCK, true, mFile);
-  } catch (...) {
-    ::close(mFd);
-    throw;
+StoreWriterLock::StoreWriterLock(const std::filesystem::path& storeDir) : mFile(storeDir / kStoreLockName) {
+  for (;;) {
+    mFd = openLockFile(mFile);
+    try {
+      LockResult r = lockByte(mFd, kWriterByte, F_WRLCK, false, mFile);
+      mExclusive = r == LockResult::Taken;
+      if (r == LockResult::Busy) r = lockByte(mFd, kWriterByte, F_RDLCK, true, mFile);
+      mLocking = r != LockResult::Unsupported;
+      mAlone = mExclusive || !mLocking;
+    } catch (...) {
+      ::close(mFd);
+      throw;
+    }
+    if (!mLocking || stillThere(mFd, mFile)) return;
+    ::close(mFd);  // locked a file another writer removed: lock the one at the path now
   }
 }
 
@@ -62,7 +78,8 @@ void StoreWriterLock::share() {
 }
 
 bool StoreWriterLock::removeFileIfAlone() {
-  if (!mExclusive && !lockByte(mFd, kWriterByte, F_WRLCK, false, mFile)) return false;
+  if (!mLocking) return false;
+  if (!mExclusive && lockByte(mFd, kWriterByte, F_WRLCK, false, mFile) != LockResult::Taken) return false;
   mExclusive = true;
   std::error_code ec;
   std::filesystem::remove(mFile, ec);
@@ -71,12 +88,17 @@ bool StoreWriterLock::removeFileIfAlone() {
 
 StoreTableLock::StoreTableLock(const std::filesystem::path& storeDir) {
   const auto file = storeDir / kStoreLockName;
-  mFd = openLockFile(file);
-  try {
-    lockByte(mFd, kTableByte, F_WRLCK, true, file);
-  } catch (...) {
+  for (;;) {
+    mFd = openLockFile(file);
+    LockResult r;
+    try {
+      r = lockByte(mFd, kTableByte, F_WRLCK, true, file);
+    } catch (...) {
+      ::close(mFd);
+      throw;
+    }
+    if (r == LockResult::Unsupported || stillThere(mFd, file)) return;
     ::close(mFd);
-    throw;
   }
 }
 

@@ -9,8 +9,10 @@
 //           (creating the store, listing a frame), so concurrent writers never lose each
 //           other's frames.
 // Readers (info, render) take no lock: store.fsh is replaced atomically and lists only frames
-// whose files are complete. On a filesystem without locks (ENOLCK, EOPNOTSUPP) both degrade to
-// no locking, and a writer then behaves as if it were alone.
+// whose files are complete. On a filesystem without locks (ENOLCK, EOPNOTSUPP: NFS mounted
+// `nolock`) both degrade to no locking (locking() is false), and a writer then behaves as if it
+// were alone: concurrent writers are not safe there, and convert --append refuses to run.
+// A lock taken on a lock file that was unlinked meanwhile is retaken on the file at the path.
 #pragma once
 
 #include <filesystem>
@@ -31,6 +33,8 @@ class StoreWriterLock {
 
   /// No other writer held the lock when this one took it (or the filesystem has no locks).
   bool alone() const { return mAlone; }
+  /// The filesystem supports the locks.
+  bool locking() const { return mLocking; }
   /// From exclusive to shared (atomically: no other writer can slip in between and find the
   /// store empty of writers); alone() stays as it was. Call once the housekeeping is done.
   void share();
@@ -43,6 +47,7 @@ class StoreWriterLock {
   int mFd = -1;
   bool mAlone = false;
   bool mExclusive = false;
+  bool mLocking = true;
 };
 
 /// The table lock of a store directory that exists, held exclusive until destruction (waits

@@ -36,7 +36,8 @@ class FakeScheduler {
           "  bash \"$script\" > \"$(echo \"$log\" | sed \"s/%j/$id/\")\" 2>&1\n"
           "fi\n"
           "echo \"$id\"\n");
-    write("squeue", "#!/bin/sh\nexit 0\n");
+    // FAKE_RUNNING=<job id>: that job is still running.
+    write("squeue", "#!/bin/sh\ncase \" $* \" in *\" $FAKE_RUNNING \"*) [ -n \"$FAKE_RUNNING\" ] && echo RUNNING;; esac\nexit 0\n");
     write("sacct", "#!/bin/sh\necho 'Slurm accounting storage is disabled' >&2\nexit 1\n");
     write("scontrol", "#!/bin/sh\nexit 1\n");
     mPath = std::getenv("PATH") ? std::getenv("PATH") : "";
@@ -71,6 +72,12 @@ TEST_F(FarmCommand, DryRunPrintsEveryScriptAndWritesNothing) {
         "#SBATCH --mem=2G", "#SBATCH --time=10:00", "--append --mem 1740M", "nothing submitted (4 jobs)"})
     EXPECT_NE(dry.output.find(expected), std::string::npos) << expected << "\n" << dry.output;
   EXPECT_FALSE(fs::exists(scenario.path("s")));
+  // A number without a unit is MiB, as Slurm reads it.
+  const CommandRun mib = runFlipscope("farm convert " + scenario.path("in/in_####.bin") + " -o " +
+                                      scenario.path("s") + " --mem 2000 --dry-run");
+  ASSERT_EQ(mib.exitCode, 0) << mib.output;
+  EXPECT_NE(mib.output.find("#SBATCH --mem=2000M"), std::string::npos) << mib.output;
+  EXPECT_NE(mib.output.find("--append --mem 1700M"), std::string::npos) << mib.output;
   // With a domain: no bounds pass, the domain also clips as in convert.
   const CommandRun domain = runFlipscope("farm convert " + scenario.path("in/in_####.bin") + " -o " +
                                          scenario.path("s") + " --domain 0,0,0,2,2,2 --dry-run");
@@ -102,6 +109,15 @@ TEST_F(FarmCommand, BadRequestsAreRefusedNamingWhatIsWrong) {
 }
 
 TEST_F(FarmCommand, ConvertEqualsASerialConvert) { scenario.convertEqualsSerial(); }
+
+TEST_F(FarmCommand, ResumeIsRefusedWhileTheLastRunStillRuns) {
+  scenario.convertEqualsSerial();
+  ::setenv("FAKE_RUNNING", "103", 1);  // the third submission: the convert array
+  const CommandRun resume = runFlipscope("farm convert --resume -o " + scenario.path("farm"));
+  ::unsetenv("FAKE_RUNNING");
+  EXPECT_EQ(resume.exitCode, 2) << resume.output;
+  EXPECT_NE(resume.output.find("still queued or running: 103"), std::string::npos) << resume.output;
+}
 
 TEST_F(FarmCommand, RenderEqualsALocalRender) {
   scenario.convertEqualsSerial();

@@ -262,5 +262,51 @@ TEST(BrickStore, MissingOrForeignDirectoryIsAClearError) {
   EXPECT_THROW(BrickStore::open(dir / "missing"), FileError);
 }
 
+TEST(BrickStore, AFramelessHeaderIsRemovedOnlyWhileItIsStillFramelessAndOurs) {
+  testing::TempDir temp("frameless");
+  StoreHeader h;
+  h.cellSize = 0.5;
+  h.brickGrid = {1, 1, 1};
+  bool wrote = false;
+  BrickStore store = BrickStore::createOrAppend(temp / "s", h, BrickStore::FramelessStore::Join, &wrote);
+  EXPECT_TRUE(wrote);
+  const StoreId id = store.header().id;
+  // A second writer joins it: nothing written, the same store.
+  BrickStore joined = BrickStore::createOrAppend(temp / "s", h, BrickStore::FramelessStore::Join, &wrote);
+  EXPECT_FALSE(wrote);
+  EXPECT_EQ(joined.header().id, id);
+  // Another store's id: left alone. The joined writer lists a frame: left alone.
+  EXPECT_FALSE(BrickStore::removeIfFrameless(temp / "s", StoreId{1}));
+  joined.addFrame(3);
+  EXPECT_FALSE(BrickStore::removeIfFrameless(temp / "s", id));
+  EXPECT_EQ(BrickStore::open(temp / "s").frames(), std::vector<int>{3});
+  // Still frameless and ours: removed.
+  BrickStore::createOrAppend(temp / "t", h, BrickStore::FramelessStore::Join, &wrote);
+  EXPECT_TRUE(BrickStore::removeIfFrameless(temp / "t", BrickStore::open(temp / "t").header().id));
+  EXPECT_FALSE(BrickStore::exists(temp / "t"));
+}
+
+TEST(BrickStore, AddFrameMergesTheFramesOtherWritersListed) {
+  testing::TempDir temp("merge");
+  StoreHeader h;
+  h.cellSize = 0.5;
+  h.brickGrid = {1, 1, 1};
+  BrickStore a = BrickStore::createOrAppend(temp / "s", h);
+  BrickStore b = BrickStore::open(temp / "s");  // opened before a lists anything
+  a.addFrame(1);
+  b.addFrame(2);
+  a.addFrame(3);
+  EXPECT_EQ(BrickStore::open(temp / "s").frames(), (std::vector<int>{1, 2, 3}));
+  // A store started anew under a writer: its next frame is refused, naming store.fsh.
+  fs::remove(temp / "s" / kStoreHeaderName);
+  BrickStore::createOrAppend(temp / "s", h);
+  try {
+    b.addFrame(4);
+    FAIL() << "a frame was listed in another store";
+  } catch (const FileError& e) {
+    EXPECT_NE(std::string(e.what()).find("is now the header of another store"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace flipscope

@@ -93,6 +93,11 @@ FarmPlan loadPlan(const std::filesystem::path& store, FarmKind kind) {
     p.camera = j.at("camera").get<std::string>();
     p.renderArgs = j.at("render_args").get<std::vector<std::string>>();
     if (p.chunk <= 0) throw FileError(file, "chunk must be positive");
+    if (p.frames.empty()) throw FileError(file, "plans no frames");
+    for (std::size_t i = 0; i < p.frames.size(); ++i)
+      if (p.frames[i] < 0 || p.frames[i] > 999999 || (i > 0 && p.frames[i] <= p.frames[i - 1]))
+        throw FileError(file, "frames must be ascending, unique, 0 to 999999 (frame " + std::to_string(p.frames[i]) +
+                                  ")");
     return p;
   } catch (const nlohmann::json::exception& e) {
     throw FileError(file, std::string("damaged: ") + e.what());

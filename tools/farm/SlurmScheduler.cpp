@@ -150,8 +150,10 @@ class SlurmScheduler : public Scheduler {
 
   bool ended(const std::string& job) override {
     const ProgramRun run = runProgram({"squeue", "-h", "-j", job, "-o", "%T"});
-    if (run.exitCode != 0) return true;  // "Invalid job id": long gone
-    return splitLines(run.output).empty();
+    if (run.exitCode == 0) return splitLines(run.output).empty();
+    // "Invalid job id specified": purged long ago. Any other error (a controller that does not
+    // answer for a moment) says nothing: not ended.
+    return run.output.find("Invalid job id") != std::string::npos;
   }
 };
 
