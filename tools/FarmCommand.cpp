@@ -121,7 +121,21 @@ void launch(std::vector<farm::FarmJob>& jobs, const FarmPlan& plan, const FarmAr
   for (const auto& job : jobs)
     for (const auto& task : job.tasks) frames.insert(frames.end(), task.begin(), task.end());
   clearLastRun(plan, frames);
-  const auto submitted = farm::submitJobs(jobs, plan, *scheduler);
+  std::vector<farm::FarmSubmission> submitted;
+  try {
+    submitted = farm::submitJobs(jobs, plan, *scheduler);
+  } catch (const InputError&) {
+    // Nothing was ever submitted for this plan: forget it, so that the same command can simply
+    // be run again once the scheduler answers.
+    const fs::path farmDir = farm::farmDirectory(plan.store, plan.kind);
+    if (!a.resume && farm::loadSubmissions(farmDir).empty()) {
+      std::error_code ec;
+      fs::remove_all(farmDir, ec);
+      for (const fs::path& dir : {farmDir.parent_path(), plan.store})
+        if (fs::is_empty(dir, ec)) fs::remove(dir, ec);
+    }
+    throw;
+  }
   std::string ids;
   for (const auto& s : submitted) {
     std::printf("submitted %s job %s%s\n", s.role.c_str(), s.job.c_str(),

@@ -22,6 +22,9 @@ class FakeScheduler {
   FakeScheduler() : mBin("farm-fake-slurm") {
     write("sbatch",
           "#!/bin/bash\n"
+          "if [ -n \"${FAKE_SBATCH_FAIL:-}\" ]; then\n"
+          "  echo 'sbatch: error: Batch job submission failed: Invalid job array specification' >&2; exit 1\n"
+          "fi\n"
           "script=\"${@: -1}\"\n"
           "counter=\"$(dirname \"$0\")/counter\"\n"
           "id=$(( $(cat \"$counter\" 2>/dev/null || echo 100) + 1 ))\n"
@@ -109,6 +112,21 @@ TEST_F(FarmCommand, BadRequestsAreRefusedNamingWhatIsWrong) {
 }
 
 TEST_F(FarmCommand, ConvertEqualsASerialConvert) { scenario.convertEqualsSerial(); }
+
+TEST_F(FarmCommand, ARefusedSubmissionLeavesNothingAndSaysWhy) {
+  ::setenv("FAKE_SBATCH_FAIL", "1", 1);
+  const CommandRun refused =
+      runFlipscope("farm convert " + scenario.path("in/in_####.bin") + " -o " + scenario.path("s"));
+  ::unsetenv("FAKE_SBATCH_FAIL");
+  EXPECT_EQ(refused.exitCode, 2) << refused.output;
+  EXPECT_NE(refused.output.find("Invalid job array specification (an array of 8 tasks: a larger --chunk makes fewer)"),
+            std::string::npos)
+      << refused.output;
+  EXPECT_FALSE(fs::exists(scenario.path("s")));  // nothing submitted: no plan left to --resume
+  const CommandRun again =
+      runFlipscope("farm convert " + scenario.path("in/in_####.bin") + " -o " + scenario.path("s") + " --wait");
+  EXPECT_EQ(again.exitCode, 0) << again.output;
+}
 
 TEST_F(FarmCommand, ResumeIsRefusedWhileTheLastRunStillRuns) {
   scenario.convertEqualsSerial();

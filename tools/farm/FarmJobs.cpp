@@ -149,10 +149,11 @@ std::vector<FarmSubmission> submitJobs(std::vector<FarmJob>& jobs, const FarmPla
       ids[job.role] = scheduler.submit(job.request);
     } catch (const InputError& refused) {
       // Slurm refuses arrays over its MaxArraySize (1001 by default): say how to make fewer tasks.
-      const InputError e(std::string(refused.what()) +
-                         (job.tasks.size() > 1 ? " (an array of " + std::to_string(job.tasks.size()) +
-                                                     " tasks: a larger --chunk makes fewer)"
-                                               : std::string()));
+      const std::string why = refused.what();
+      const bool arrayRefused = job.tasks.size() > 1 && why.find("array") != std::string::npos;
+      const InputError e(why + (arrayRefused ? " (an array of " + std::to_string(job.tasks.size()) +
+                                                   " tasks: a larger --chunk makes fewer)"
+                                             : std::string()));
       if (submitted.empty()) throw e;
       std::string before;
       for (const auto& s : submitted) before += " " + s.job;
