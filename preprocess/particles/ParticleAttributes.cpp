@@ -1,5 +1,6 @@
 // Attribute names and types shared by every reader (ParticleSource.h, ParticleFormats.h).
 #include <algorithm>
+#include <cstring>
 
 #include "core/Error.h"
 #include "preprocess/particles/ParticleFormats.h"
@@ -57,6 +58,33 @@ void detail::syncColumns(std::vector<AttributeColumn>& columns, const std::vecto
     if (columns[i].name != expected[i].name) columns[i].name = expected[i].name;
     columns[i].arity = expected[i].arity;
     columns[i].values.clear();
+  }
+}
+
+void detail::fillFromFloatStreams(ParticleChunk& chunk, std::size_t n, const FloatStreams& streams,
+                                  const std::vector<AttributeDesc>& attributes, const std::vector<std::size_t>& selected,
+                                  const std::function<int(std::size_t)>& arity,
+                                  const std::function<void(std::size_t, std::size_t, float*)>& read) {
+  std::vector<const float*> done(streams.count, nullptr);  // per stream: where its values went
+  auto fill = [&](std::size_t stream, float* out) {
+    if (done[stream])
+      std::memcpy(out, done[stream], n * std::size_t(arity(stream)) * sizeof(float));
+    else
+      read(stream, n, out);
+    done[stream] = out;
+  };
+  static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
+  chunk.positions.resize(n);
+  fill(0, &chunk.positions[0].x);
+  chunk.velocities.resize(streams.velocity ? n : 0);
+  if (streams.velocity) fill(streams.velocityStream, &chunk.velocities[0].x);
+  chunk.attributes.resize(selected.size());
+  for (std::size_t i = 0; i < selected.size(); ++i) {
+    AttributeColumn& column = chunk.attributes[i];
+    column.name = attributes[selected[i]].name;
+    column.arity = attributes[selected[i]].arity;
+    column.values.resize(n * std::size_t(column.arity));
+    fill(streams.columnStreams[i], column.values.data());
   }
 }
 

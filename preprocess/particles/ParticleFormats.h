@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -86,5 +87,22 @@ std::vector<AttributeColumn> makeColumns(const std::vector<AttributeDesc>& avail
 /// Gives a chunk's `columns` the names and arities of `expected` (the reader's makeColumns),
 /// keeping their storage: a chunk may come from another source or be new.
 void syncColumns(std::vector<AttributeColumn>& columns, const std::vector<AttributeColumn>& expected);
+
+/// Where the values of a chunk come from in a reader of float arrays (VTK legacy and XML):
+/// stream 0 holds the positions, `velocityStream` the velocities (when `velocity`), and
+/// columnStreams[i] the attribute `attributes[selected[i]]`.
+struct FloatStreams {
+  std::size_t count = 0;  ///< streams
+  bool velocity = false;
+  std::size_t velocityStream = 0;
+  std::vector<std::size_t> columnStreams;
+};
+/// Fills `chunk` with the next `n` particles of `streams`: read(stream, n, out) reads n
+/// particles' values of a stream (arity(stream) floats each). A stream used twice is read once
+/// and copied. The chunk's arrays are resized, not cleared: the same size is not initialised again.
+void fillFromFloatStreams(ParticleChunk& chunk, std::size_t n, const FloatStreams& streams,
+                          const std::vector<AttributeDesc>& attributes, const std::vector<std::size_t>& selected,
+                          const std::function<int(std::size_t)>& arity,
+                          const std::function<void(std::size_t, std::size_t, float*)>& read);
 
 }  // namespace flipscope::detail

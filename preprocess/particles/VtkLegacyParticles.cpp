@@ -434,30 +434,11 @@ class VtkLegacyReader final : public ParticleSource {
       chunk.attributes.clear();
       return false;
     }
-    // Resized, not cleared: a chunk of the same size is not initialised again.
-    // Each array is read once, straight into the chunk; a second use of it copies the first.
-    mRead.assign(mStreams.size(), nullptr);
-    auto fill = [&](std::size_t stream, float* out) {
-      const std::size_t count = std::size_t(n) * std::size_t(mStreams[stream].array->desc.arity);
-      if (mRead[stream])
-        std::memcpy(out, mRead[stream], count * sizeof(float));
-      else
-        readStream(mStreams[stream], n, out);
-      mRead[stream] = out;
-    };
-    static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
-    chunk.positions.resize(n);
-    fill(0, &chunk.positions[0].x);
-    chunk.velocities.resize(mVelocity ? n : 0);
-    if (mVelocity) fill(mVelocityStream, &chunk.velocities[0].x);
-    chunk.attributes.resize(mSelected.size());
-    for (std::size_t i = 0; i < mSelected.size(); ++i) {
-      AttributeColumn& column = chunk.attributes[i];
-      column.name = mAttributes[mSelected[i]].name;
-      column.arity = mAttributes[mSelected[i]].arity;
-      column.values.resize(std::size_t(n) * std::size_t(column.arity));
-      fill(mColumnStreams[i], column.values.data());
-    }
+    const detail::FloatStreams streams{mStreams.size(), mVelocity.has_value(), mVelocityStream, mColumnStreams};
+    detail::fillFromFloatStreams(
+        chunk, std::size_t(n), streams, mAttributes, mSelected,
+        [&](std::size_t stream) { return int(mStreams[stream].array->desc.arity); },
+        [&](std::size_t stream, std::size_t count, float* out) { readStream(mStreams[stream], count, out); });
     mNext += n;
     return true;
   }
@@ -545,7 +526,6 @@ class VtkLegacyReader final : public ParticleSource {
   std::vector<Stream> mStreams;  ///< [0]: the positions
   std::size_t mVelocityStream = 0;
   std::vector<std::size_t> mColumnStreams;
-  std::vector<const float*> mRead;  ///< per stream: where this chunk's values went
   std::uint64_t mNext = 0;
 };
 

@@ -740,30 +740,11 @@ class VtkXmlReader final : public ParticleSource {
     if (mStreams.empty()) openStreams();
     const XmlPiece& piece = mLayout.pieces[mPiece];
     const std::uint64_t n = std::min<std::uint64_t>(maxParticles, piece.points - mInPiece);
-    // Each array is read once, straight into the chunk; a second use of it copies the first.
-    mRead.assign(mStreams.size(), nullptr);
-    auto fill = [&](std::size_t stream, float* out) {
-      const std::size_t count = std::size_t(n) * std::size_t(mStreams[stream].arity);
-      if (mRead[stream])
-        std::memcpy(out, mRead[stream], count * sizeof(float));
-      else
-        mStreams[stream].stream->read(out, count);
-      mRead[stream] = out;
-    };
-    static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
-    chunk.positions.resize(n);
-    fill(0, &chunk.positions[0].x);
-    // Resized, not cleared: a chunk of the same size is not initialised again.
-    chunk.velocities.resize(mVelocity ? n : 0);
-    if (mVelocity) fill(mVelocityStream, &chunk.velocities[0].x);
-    chunk.attributes.resize(mSelected.size());
-    for (std::size_t i = 0; i < mSelected.size(); ++i) {
-      AttributeColumn& column = chunk.attributes[i];
-      column.name = mAttributes[mSelected[i]].name;
-      column.arity = mAttributes[mSelected[i]].arity;
-      column.values.resize(std::size_t(n) * std::size_t(column.arity));
-      fill(mColumnStreams[i], column.values.data());
-    }
+    const detail::FloatStreams streams{mStreams.size(), mVelocity.has_value(), mVelocityStream, mColumnStreams};
+    detail::fillFromFloatStreams(
+        chunk, std::size_t(n), streams, mAttributes, mSelected,
+        [&](std::size_t stream) { return int(mStreams[stream].arity); },
+        [&](std::size_t stream, std::size_t count, float* out) { mStreams[stream].stream->read(out, count * std::size_t(mStreams[stream].arity)); });
     mInPiece += n;
     return true;
   }
@@ -815,7 +796,6 @@ class VtkXmlReader final : public ParticleSource {
   std::vector<Stream> mStreams;  ///< of the current piece; [0]: the points
   std::size_t mVelocityStream = 0;
   std::vector<std::size_t> mColumnStreams;
-  std::vector<const float*> mRead;  ///< per stream: where this chunk's values went
 };
 
 }  // namespace
