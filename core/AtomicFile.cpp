@@ -238,6 +238,10 @@ void writeFileAtomically(const std::filesystem::path& destination, std::span<con
   file.commit();
 }
 
+void writeTextAtomically(const std::filesystem::path& destination, std::string_view text) {
+  writeFileAtomically(destination, std::as_bytes(std::span(text.data(), text.size())));
+}
+
 std::vector<std::byte> readFile(const std::filesystem::path& path) {
   std::FILE* f = std::fopen(path.c_str(), "rb");
   if (!f) throw FileError(path, "cannot open: " + errnoText());

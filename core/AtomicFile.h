@@ -113,6 +113,9 @@ class AtomicFile {
 /// Writes `bytes` to `destination` atomically.
 void writeFileAtomically(const std::filesystem::path& destination, std::span<const std::byte> bytes);
 
+/// Writes `text` to `destination` atomically (JSON, scripts, summaries).
+void writeTextAtomically(const std::filesystem::path& destination, std::string_view text);
+
 /// Reads a whole file. Throws FileError when it cannot be opened or read.
 std::vector<std::byte> readFile(const std::filesystem::path& path);
 

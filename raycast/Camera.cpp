@@ -153,8 +153,7 @@ void saveCamera(const std::filesystem::path& file, const Camera& camera) {
                                {"target", {camera.target.x, camera.target.y, camera.target.z}},
                                {"up", {camera.up.x, camera.up.y, camera.up.z}},
                                {"fov", camera.fovYDegrees}};
-  const std::string text = json.dump(2) + "\n";
-  writeFileAtomically(file, std::as_bytes(std::span(text.data(), text.size())));
+  writeTextAtomically(file, json.dump(2) + "\n");
 }
 
 }  // namespace flipscope

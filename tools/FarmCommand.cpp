@@ -94,6 +94,19 @@ void refuseWhileRunning(const FarmPlan& plan) {
                      "; wait for them (farm status) or cancel them first");
 }
 
+/// A --resume: the saved plan with the options given over it, and the frames that are not done
+/// (none: it says so).
+FarmPlan planToResume(const fs::path& store, FarmKind kind, const FarmArgs& a, std::vector<int>& todo) {
+  FarmPlan plan = farm::loadPlan(store, kind);
+  fillCommon(plan, a);
+  if (!a.dryRun) refuseWhileRunning(plan);
+  todo = framesNotDone(plan);
+  if (todo.empty())
+    std::printf("farm %s --resume: all %zu frames of %s are done\n", farm::farmKindName(kind), plan.frames.size(),
+                store.c_str());
+  return plan;
+}
+
 /// Before a submission: the summary and the failure logs of the frames about to run again go,
 /// so that neither describes the last run.
 void clearLastRun(const FarmPlan& plan, const std::vector<int>& frames) {
@@ -101,11 +114,7 @@ void clearLastRun(const FarmPlan& plan, const std::vector<int>& frames) {
   std::error_code ec;
   fs::remove(farmDir / "summary.txt", ec);
   fs::remove(farmDir / "summary.json", ec);
-  for (int f : frames) {
-    char name[32];
-    std::snprintf(name, sizeof name, "frame_%06d.log", f);
-    fs::remove(farmDir / "failed" / name, ec);
-  }
+  for (int f : frames) fs::remove(farm::failureLogPath(farmDir, f), ec);
 }
 
 /// Submits (or, with --dry-run, prints) `jobs`, then reports how to follow them; with --wait,
@@ -192,16 +201,10 @@ void runFarmConvert(const ConvertFarmArgs& a) {
   std::vector<int> todo;
   bool prepare = true;
   if (a.farm.resume) {
-    plan = farm::loadPlan(store, FarmKind::Convert);
     if (!a.inputs.empty()) throw InputError("farm convert --resume: the inputs come from the plan; give none");
-    fillCommon(plan, a.farm);
-    if (!a.farm.dryRun) refuseWhileRunning(plan);
+    plan = planToResume(store, FarmKind::Convert, a.farm, todo);
+    if (todo.empty()) return;
     prepare = !BrickStore::exists(store);  // the prepare job failed: write the header this time
-    todo = framesNotDone(plan);
-    if (todo.empty()) {
-      std::printf("farm convert --resume: all %zu frames of %s are done\n", plan.frames.size(), store.c_str());
-      return;
-    }
   } else {
     if (a.inputs.empty()) throw InputError("farm convert: no inputs");
     if (fs::exists(farm::farmDirectory(store, FarmKind::Convert) / "plan.json") && !a.farm.dryRun)
@@ -260,14 +263,8 @@ void runFarmRender(const RenderFarmArgs& a, const std::vector<std::string>& extr
   FarmPlan plan;
   std::vector<int> todo;
   if (a.farm.resume) {
-    plan = farm::loadPlan(store, FarmKind::Render);
-    fillCommon(plan, a.farm);
-    if (!a.farm.dryRun) refuseWhileRunning(plan);
-    todo = framesNotDone(plan);
-    if (todo.empty()) {
-      std::printf("farm render --resume: all %zu frames of %s are rendered\n", plan.frames.size(), store.c_str());
-      return;
-    }
+    plan = planToResume(store, FarmKind::Render, a.farm, todo);
+    if (todo.empty()) return;
   } else {
     if (a.output.empty()) throw InputError("farm render: -o OUTPUT is required");
     if (a.output.find('#') == std::string::npos)

@@ -52,10 +52,9 @@ void writeTaskBounds(const farm::FarmPlan& plan, int task, const std::vector<int
     json["min"] = {bounds.min.x, bounds.min.y, bounds.min.z};
     json["max"] = {bounds.max.x, bounds.max.y, bounds.max.z};
   }
-  const std::string text = json.dump(2) + "\n";
   const fs::path file = boundsFile(plan, task);
   fs::create_directories(file.parent_path());
-  writeFileAtomically(file, std::as_bytes(std::span(text.data(), text.size())));
+  writeTextAtomically(file, json.dump(2) + "\n");
 }
 
 /// The union of every task's bounds: the domain of the store, as convert would find it; and the

@@ -142,7 +142,7 @@ std::vector<FarmSubmission> submitJobs(std::vector<FarmJob>& jobs, const FarmPla
   for (auto& job : jobs) {
     for (auto* roles : {&job.request.afterOk, &job.request.afterAny})
       for (auto& role : *roles) role = ids.at(role);
-    writeFileAtomically(job.request.script, std::as_bytes(std::span(job.script.data(), job.script.size())));
+    writeTextAtomically(job.request.script, job.script);
     std::filesystem::permissions(job.request.script, std::filesystem::perms::owner_exec,
                                  std::filesystem::perm_options::add);
     try {

@@ -12,8 +12,7 @@ namespace flipscope::farm {
 namespace {
 
 void writeJson(const std::filesystem::path& file, const nlohmann::json& json) {
-  const std::string text = json.dump(2) + "\n";
-  writeFileAtomically(file, std::as_bytes(std::span(text.data(), text.size())));
+  writeTextAtomically(file, json.dump(2) + "\n");
 }
 
 nlohmann::json readJson(const std::filesystem::path& file) {

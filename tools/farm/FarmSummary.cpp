@@ -13,9 +13,7 @@ namespace {
 /// The reason a task wrote for `frame`: the first line flipscope reported as an error (it names
 /// the file and what is wrong), else the log's last line; empty when there is no log.
 std::string failureReason(const std::filesystem::path& farm, int frame) {
-  char name[32];
-  std::snprintf(name, sizeof name, "frame_%06d.log", frame);
-  std::ifstream in(farm / "failed" / name);
+  std::ifstream in(failureLogPath(farm, frame));
   std::string line, error, last;
   while (std::getline(in, line)) {
     if (line.empty()) continue;
@@ -25,11 +23,13 @@ std::string failureReason(const std::filesystem::path& farm, int frame) {
   return error.empty() ? last : error;
 }
 
-void writeText(const std::filesystem::path& file, const std::string& text) {
-  writeFileAtomically(file, std::as_bytes(std::span(text.data(), text.size())));
-}
-
 }  // namespace
+
+std::filesystem::path failureLogPath(const std::filesystem::path& farmDir, int frame) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%06d.log", frame);
+  return farmDir / "failed" / name;
+}
 
 FarmSummary summarize(const FarmPlan& plan, const std::function<FrameCheck(int)>& check,
                       const std::string& noResult) {
@@ -68,8 +68,8 @@ void writeSummary(const FarmSummary& s, const FarmPlan& plan) {
   const nlohmann::json json = {{"kind", farmKindName(s.kind)}, {"store", plan.store.string()},
                                {"planned", s.planned},         {"done", s.done},
                                {"missing", missing},           {"complete", s.complete()}};
-  writeText(farm / "summary.json", json.dump(2) + "\n");
-  writeText(farm / "summary.txt", summaryText(s, plan));
+  writeTextAtomically(farm / "summary.json", json.dump(2) + "\n");
+  writeTextAtomically(farm / "summary.txt", summaryText(s, plan));
 }
 
 }  // namespace flipscope::farm

@@ -33,6 +33,9 @@ struct FrameCheck {
   std::string problem;
 };
 
+/// failed/frame_NNNNNN.log in `farmDir`: where a task writes why `frame` failed (FarmJobs.h).
+std::filesystem::path failureLogPath(const std::filesystem::path& farmDir, int frame);
+
 /// Checks every planned frame with `check`. `noResult`: the reason of a frame that is not done
 /// and has no failure log.
 FarmSummary summarize(const FarmPlan& plan, const std::function<FrameCheck(int)>& check, const std::string& noResult);

@@ -37,6 +37,15 @@ std::vector<std::string> splitFields(const std::string& line, char separator) {
   return fields;
 }
 
+/// A task named by Slurm's id of it: "<job>_<index>" for an array task, "<job>" for a job.
+TaskState taskWithId(const std::string& id) {
+  TaskState s;
+  const auto underscore = id.find('_');
+  s.job = id.substr(0, underscore);
+  s.task = underscore == std::string::npos ? "" : id.substr(underscore + 1);
+  return s;
+}
+
 /// The first line of a tool's output, for error messages.
 std::string firstLine(const std::string& output) {
   const auto lines = splitLines(output);
@@ -97,10 +106,7 @@ class SlurmScheduler : public Scheduler {
       for (const auto& line : splitLines(sacct.output)) {
         const auto f = splitFields(line, '|');
         if (f.size() < 5) continue;
-        TaskState s;
-        const auto underscore = f[0].find('_');
-        s.job = f[0].substr(0, underscore);
-        s.task = underscore == std::string::npos ? "" : f[0].substr(underscore + 1);
+        TaskState s = taskWithId(f[0]);
         s.name = f[1], s.state = f[2].substr(0, f[2].find(' ')), s.exitCode = f[3], s.elapsed = f[4];
         put(s);
       }
@@ -129,10 +135,7 @@ class SlurmScheduler : public Scheduler {
       for (const auto& line : splitLines(squeue.output)) {
         const auto f = splitFields(line, '|');
         if (f.size() < 5) continue;
-        TaskState s;
-        const auto underscore = f[0].find('_');
-        s.job = f[0].substr(0, underscore);
-        s.task = underscore == std::string::npos ? "" : f[0].substr(underscore + 1);
+        TaskState s = taskWithId(f[0]);
         s.name = f[1], s.state = f[2], s.elapsed = f[3], s.reason = f[4] == "None" ? "" : f[4];
         put(s);
       }
