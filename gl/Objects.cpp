@@ -90,6 +90,12 @@ void Buffer::clearZero() {
   glClearNamedBufferData(mId, GL_R8UI, GL_RED_INTEGER, GL_UNSIGNED_BYTE, nullptr);  // null data: zeros
 }
 
+void Buffer::clearZero(std::uint64_t offset, std::uint64_t bytes) {
+  FLIPSCOPE_CHECK(mId != 0 && offset + bytes <= mSize && offset % 4 == 0 && bytes % 4 == 0);
+  glClearNamedBufferSubData(mId, GL_R32UI, GLintptr(offset), GLsizeiptr(bytes), GL_RED_INTEGER, GL_UNSIGNED_INT,
+                            nullptr);
+}
+
 void Buffer::bindBase(GLenum target, GLuint index) const {
   FLIPSCOPE_CHECK(mId != 0, "binding an empty buffer at " << index);
   glBindBufferBase(target, index, mId);

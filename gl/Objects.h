@@ -31,6 +31,8 @@ class Buffer {
   void download(std::uint64_t offset, std::uint64_t bytes, void* data) const;
   /// Sets every byte to zero.
   void clearZero();
+  /// Sets `bytes` bytes from byte `offset` to zero (both multiples of 4, within size()).
+  void clearZero(std::uint64_t offset, std::uint64_t bytes);
   /// glBindBufferBase(target, index, id()), e.g. GL_SHADER_STORAGE_BUFFER or GL_UNIFORM_BUFFER.
   void bindBase(GLenum target, GLuint index) const;
 

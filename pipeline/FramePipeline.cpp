@@ -1,5 +1,6 @@
 #include "pipeline/FramePipeline.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -69,11 +70,20 @@ FramePipeline::FramePipeline(BrickStore store, DeviceChoice device, const Render
                              const SurfaceSettings& surface, std::string* fallbackReason)
     : FramePipeline(std::make_shared<StoreBrickSource>(std::move(store)), device, settings, surface, fallbackReason) {}
 
-FramePipeline::FramePipeline(std::shared_ptr<BrickSource> source, DeviceChoice device, const RenderSettings& settings,
+float thicknessSaturationCells(const ShadingOptions& shading) {
+  // §3.6: the trace behind a hit goes on until the least absorbed channel keeps 1% (ln 100).
+  const float weakest = std::min({shading.absorption.x, shading.absorption.y, shading.absorption.z});
+  return weakest > 0 ? std::min(4.6051702f / weakest, float(kThicknessMaxCells)) : float(kThicknessMaxCells);
+}
+
+FramePipeline::FramePipeline(std::shared_ptr<BrickSource> source, DeviceChoice device, const RenderSettings& requested,
                              const SurfaceSettings& surface, std::string* fallbackReason)
     : mSurface(surface) {
+  RenderSettings settings = requested;
+  settings.thicknessSaturationCells = thicknessSaturationCells(surface.shading);
   validate(settings);
   mSurface.smoothing = resolve(surface.smoothing);
+  mSurface.shading.foam = settings.foam.mode == FoamMode::Volume;
   if (surface.shading.colorByAttribute && source->header().attribute == AttributeKind::None)
     throw InputError(source->name() +
                      ": the store has no per-particle attribute to colour by (convert with --attribute)");
@@ -180,6 +190,11 @@ FrameOutput FramePipeline::render(int frame, const Camera& camera, int direction
     image.unsmoothedDepth.resize(n);
     image.thickness.resize(n);
     image.normal.resize(n);
+    if (mSurface.shading.foam) {
+      const auto hitExtras = device.download(s.sphereNormals);
+      image.foam.resize(n);
+      for (std::size_t i = 0; i < n; ++i) image.foam[i] = glm::vec4(mSurface.shading.foamColour * hitExtras[i].w, hitExtras[i].w);
+    }
     if (attribute) {
       image.attribute.resize(n);
       image.attributeName = header.attributeName;

@@ -53,7 +53,8 @@ struct StageTimes {
 struct FrameOutput {
   int frame = 0;
   /// rgba: the shaded frame (alpha 1, the environment behind the liquid); depth: the smoothed
-  /// surface (+inf on the background); unsmoothedDepth; normal (smoothed); thickness; attribute
+  /// surface (+inf on the background); unsmoothedDepth; normal (smoothed); thickness; foam (with
+  /// --foam volume: its premultiplied colour and opacity, composited into rgba); attribute
   /// (when the store has one: the value of the nearest hit cell, the largest of its particles'
   /// 16-bit values, in the attribute's units; 0 on the background), named after the attribute.
   RenderImage image;
@@ -63,7 +64,8 @@ struct FrameOutput {
 
 class FramePipeline {
  public:
-  /// Renders the bricks of `source`, shared with the ray-caster's Streamer. Throws InputError
+  /// Renders the bricks of `source`, shared with the ray-caster's Streamer (`settings` as given,
+  /// but for the thickness trace, which thicknessSaturationCells sets). Throws InputError
   /// for bad settings, FileError for an unreadable environment map, and gl::Unavailable when
   /// `device` is Gpu and there is none. `fallbackReason` says why Auto chose the CPU.
   FramePipeline(std::shared_ptr<BrickSource> source, DeviceChoice device, const RenderSettings& settings,
@@ -91,6 +93,10 @@ class FramePipeline {
   std::unique_ptr<Stages> mStages;
   SurfaceSettings mSurface;
 };
+
+/// Liquid cells at which the thickness trace behind a hit stops (§3.6): where the channel that
+/// `shading` absorbs least keeps 1% of the light, at most kThicknessMaxCells.
+float thicknessSaturationCells(const ShadingOptions& shading);
 
 /// Loads an equirectangular environment (any EXR with R, G, B). Throws FileError naming `path`.
 EnvironmentMap loadEnvironmentMap(const std::filesystem::path& path);

@@ -8,12 +8,14 @@
 namespace flipscope {
 
 std::uint64_t PoolLayout::slotBytes() const {
-  return std::uint64_t(subBricksPerSlot) * (16 + (attributes ? 4 : 0)) + std::uint64_t(mipWordsPerSlot) * 4;
+  return std::uint64_t(subBricksPerSlot) * (16 + (attributes ? 4 : 0) + (foam ? 16 : 0)) +
+         std::uint64_t(mipWordsPerSlot) * 4;
 }
 
 PoolLayout PoolLayout::forBudget(std::uint32_t brickSize, std::uint32_t overlap, bool attributes,
-                                 std::uint64_t budgetBytes) {
+                                 std::uint64_t budgetBytes, bool foam) {
   PoolLayout layout;
+  layout.foam = foam;
   layout.brickSize = brickSize;
   layout.overlap = overlap;
   const glm::uvec3 dims = bitBrickSubBrickDims(brickSize, overlap);

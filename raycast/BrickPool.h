@@ -26,16 +26,18 @@ struct PoolLayout {
   std::uint32_t mipWordsPerSlot = 0;
   std::uint32_t mipLevels = 0;
   bool attributes = false;
+  bool foam = false;  ///< a foam bit-brick per slot (§3.5), the size of its bits
   std::uint32_t slots = 0;
   std::uint64_t attributeCapacity = 0;  ///< 16-bit entries in the ring (even)
 
-  /// Fixed bytes per slot: bits, mipmap and (with attributes) one 32-bit base per sub-brick.
+  /// Fixed bytes per slot: bits, mipmap, (with attributes) one 32-bit base per sub-brick and
+  /// (with foam) the foam bits.
   std::uint64_t slotBytes() const;
   std::uint64_t bytes() const { return slotBytes() * slots + attributeCapacity * 2; }
   /// The largest pool within `budgetBytes`; with attributes, the ring gets room for about 35%
   /// filled bricks. Throws InputError when fewer than 3 slots fit (naming the minimum budget).
   static PoolLayout forBudget(std::uint32_t brickSize, std::uint32_t overlap, bool attributes,
-                              std::uint64_t budgetBytes);
+                              std::uint64_t budgetBytes, bool foam = false);
 };
 
 class BrickPool {

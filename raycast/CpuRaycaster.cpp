@@ -30,8 +30,22 @@ struct RaycastKernel {
   }
   uint rcAttribute(uint index) const { return pool->attributes[index]; }
   void rcRequest(uint brickIndex) const { requestFlags[brickIndex].store(1, std::memory_order_relaxed); }
+  uvec4 rcFoamSubBrick(uint slot, uint subBrick) const {
+    return pool->foamBits[std::size_t(slot) * P.brick.w + subBrick];
+  }
 
 #include "raycast/glsl/Raycast.glsl"
+};
+
+/// FoamClassify.glsl compiled as C++, the same way.
+struct FoamKernel {
+  FoamClassifyParams FP;
+  const CpuRaycaster::Pool* pool;
+
+  uvec4 fcSubBrick(uint slot, uint subBrick) const { return pool->subBricks[std::size_t(slot) * FP.brick.z + subBrick]; }
+  uvec4 fcFoam(uint slot, uint subBrick) const { return pool->foamBits[std::size_t(slot) * FP.brick.z + subBrick]; }
+
+#include "raycast/glsl/FoamClassify.glsl"
 };
 }  // namespace
 }  // namespace glsl
@@ -61,6 +75,8 @@ void CpuRaycaster::allocatePool(const PoolLayout& layout) {
   mPool.attributeBases.resize(layout.attributes ? std::size_t(layout.slots) * layout.subBricksPerSlot : 0);
   mPool.attributes.clear();
   mPool.attributes.resize(layout.attributeCapacity);
+  mPool.foamBits.clear();
+  mPool.foamBits.resize(layout.foam ? std::size_t(layout.slots) * layout.subBricksPerSlot : 0);
 }
 
 void CpuRaycaster::setOctree(std::span<const OctreeNode> nodes) {
@@ -86,6 +102,31 @@ void CpuRaycaster::uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset
     FLIPSCOPE_CHECK(attributeOffset + brick.bits.attributes.size() <= mPool.attributes.size());
     std::copy(brick.bits.attributes.begin(), brick.bits.attributes.end(), mPool.attributes.begin() + attributeOffset);
   }
+  if (layout.foam) {
+    const auto foam = mPool.foamBits.begin() + std::size_t(slot) * layout.subBricksPerSlot;
+    if (brick.foamKinds.empty()) {
+      std::fill(foam, foam + layout.subBricksPerSlot, glm::uvec4(0));
+    } else {
+      FLIPSCOPE_CHECK(brick.foamKinds.size() == layout.subBricksPerSlot);
+      std::copy(brick.foamKinds.begin(), brick.foamKinds.end(), foam);
+    }
+  }
+}
+
+void CpuRaycaster::classifyFoam(std::span<const std::uint32_t> slots, const FoamClassifyParams& params) {
+  const PoolLayout& layout = mPool.layout;
+  FLIPSCOPE_CHECK(layout.foam && params.brick.z == layout.subBricksPerSlot &&
+                  params.brick.w == slots.size() * layout.subBricksPerSlot);
+  const auto start = std::chrono::steady_clock::now();
+  const glsl::FoamKernel kernel{params, &mPool};
+  // In place, as on the GPU: a sub-brick's classification reads no foam bits but its own.
+  tbb::parallel_for(std::size_t(0), slots.size(), [&](std::size_t i) {
+    FLIPSCOPE_CHECK(slots[i] < layout.slots);
+    glsl::FoamKernel local = kernel;
+    glm::uvec4* foam = &mPool.foamBits[std::size_t(slots[i]) * layout.subBricksPerSlot];
+    for (std::uint32_t s = 0; s < layout.subBricksPerSlot; ++s) foam[s] = local.fcClassify(slots[i], s);
+  });
+  mLastClassifyMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
 void CpuRaycaster::beginImage(std::uint32_t width, std::uint32_t height) {

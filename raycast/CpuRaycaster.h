@@ -1,6 +1,7 @@
 // CpuRaycaster: the C++ reference of the compute ray-caster. It runs raycast/glsl/Raycast.glsl
-// compiled as C++ (see core/GlslShared.h) over a pool held in plain arrays, one TBB task per
-// image row, so tests can compare the GPU's images with it pixel by pixel.
+// and raycast/glsl/FoamClassify.glsl compiled as C++ (see core/GlslShared.h) over a pool held in
+// plain arrays, one TBB task per image row (per sub-brick for the foam), so tests can compare the
+// GPU's images with it pixel by pixel.
 #pragma once
 
 #include <atomic>
@@ -18,6 +19,8 @@ class CpuRaycaster : public RaycastDevice {
   void setOctree(std::span<const OctreeNode> nodes) override;
   void setPageTable(std::span<const std::uint32_t> pageTable) override;
   void uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset, const ConvertedBrick& brick) override;
+  void classifyFoam(std::span<const std::uint32_t> slots, const FoamClassifyParams& params) override;
+  double lastClassifyMs() const override { return mLastClassifyMs; }
   void beginImage(std::uint32_t width, std::uint32_t height) override;
   std::vector<std::uint32_t> trace(const RaycastParams& params) override;
   double lastTraceMs() const override { return mLastTraceMs; }
@@ -36,6 +39,7 @@ class CpuRaycaster : public RaycastDevice {
     UninitializedVector<std::uint32_t> mipWords;
     UninitializedVector<std::uint32_t> attributeBases;
     UninitializedVector<std::uint16_t> attributes;
+    UninitializedVector<glm::uvec4> foamBits;  ///< with a foam pool: per slot, as subBricks
   };
   const Pool& pool() const { return mPool; }
 
@@ -44,6 +48,7 @@ class CpuRaycaster : public RaycastDevice {
   std::vector<RayHit> mHits;
   std::uint32_t mWidth = 0, mHeight = 0;
   double mLastTraceMs = 0;
+  double mLastClassifyMs = 0;
 };
 
 }  // namespace flipscope

@@ -26,6 +26,16 @@ std::uint32_t sphereReach(float radius, float jitter) {
   return std::uint32_t(std::ceil(double(radius) + double(jitter) + 0.5) - 1.0);
 }
 
+std::uint32_t storedOverlap(const RenderSettings& settings) {
+  const std::uint32_t reach = sphereReach(settings.radius, settings.jitter);
+  if (settings.foam.mode == FoamMode::Keep) return reach;
+  std::uint32_t overlap = reach + std::uint32_t(std::floor(settings.radius));
+  // The volume's trilinear density at points of the brick reads 4^3 blocks from stored cell
+  // 4 * floor(n / 4 - 1/2) on: n >= 6 keeps them clear of the outermost cells.
+  if (settings.foam.mode == FoamMode::Volume) overlap = std::max(overlap, 6u);
+  return std::min(overlap, kMaxOverlap);
+}
+
 float defaultSphereRadius(const StoreHeader& header, float jitter) {
   if (!(header.particleSpacing > 0) || !(header.cellSize > 0)) return 1.0f;
   float radius = std::max(1.0f, float(kDefaultRadiusPerSpacing * header.particleSpacing / header.cellSize));
@@ -46,13 +56,16 @@ void validate(const RenderSettings& s) {
     throw InputError("--radius plus jitter reach " + std::to_string(sphereReach(s.radius, s.jitter)) +
                      " cells; at most " + std::to_string(kMaxOverlap) + " fit the bit-brick border");
   if (s.maxPasses < 1) throw InputError("--max-passes: must be at least 1");
+  validate(s.foam);
+  if (!(s.thicknessSaturationCells >= 0.0f) || !std::isfinite(s.thicknessSaturationCells))
+    throw InputError("thickness saturation must be 0 or a positive number of cells");
 }
 
 namespace {
 StreamerOptions streamerOptions(const StoreHeader& header, const RenderSettings& settings, std::uint32_t reach) {
   StreamerOptions options;
   options.conversion.brickSize = header.brickSize;
-  options.conversion.overlap = reach;
+  options.conversion.overlap = storedOverlap(settings);
   options.conversion.attribute =
       header.attribute == AttributeKind::None ? AttributeReduction::None : AttributeReduction::Max;
   options.mipDilation = reach;
@@ -63,13 +76,13 @@ StreamerOptions streamerOptions(const StoreHeader& header, const RenderSettings&
 }
 
 /// The pool within the budget, shrunk until its largest buffer (the bits) fits the device.
-PoolLayout poolLayout(const StoreHeader& header, const RenderSettings& settings, std::uint32_t reach,
-                      std::uint64_t maxBufferBytes) {
+PoolLayout poolLayout(const StoreHeader& header, const RenderSettings& settings, std::uint64_t maxBufferBytes) {
   validate(settings);
   const bool attributes = header.attribute != AttributeKind::None;
+  const bool foam = settings.foam.mode != FoamMode::Keep;
   std::uint64_t budget = settings.gpuBudgetBytes;
   for (;;) {
-    PoolLayout layout = PoolLayout::forBudget(header.brickSize, reach, attributes, budget);
+    PoolLayout layout = PoolLayout::forBudget(header.brickSize, storedOverlap(settings), attributes, budget, foam);
     const std::uint64_t bits = std::uint64_t(layout.slots) * layout.subBricksPerSlot * 16;
     const std::uint64_t ring = layout.attributeCapacity * 2;
     if (bits <= maxBufferBytes && ring <= maxBufferBytes) return layout;
@@ -91,7 +104,8 @@ FrameRenderer::FrameRenderer(std::shared_ptr<BrickSource> source, std::unique_pt
       mDevice(std::move(device)),
       mSettings(settings),
       mReach(sphereReach(settings.radius, settings.jitter)),
-      mPool(poolLayout(mSource->header(), settings, mReach, mDevice->maxBufferBytes())) {
+      mOverlap(storedOverlap(settings)),
+      mPool(poolLayout(mSource->header(), settings, mDevice->maxBufferBytes())) {
   mDevice->allocatePool(mPool.layout());
   mStreamer = std::make_unique<Streamer>(mSource, streamerOptions(mSource->header(), settings, mReach));
 }
@@ -111,14 +125,29 @@ RaycastParams FrameRenderer::params(const Camera& camera, const FrameIndex& fram
   p.up = glm::vec4(glm::vec3(camera.trueUp()), float(h.cellSize));
   p.image = glm::uvec4(mSettings.width, mSettings.height, std::uint32_t(frame.frame), 0);
   p.grid = glm::uvec4(h.brickGrid, h.brickSize);
-  p.brick = glm::uvec4(mReach, mReach, frame.octree.levels, layout.subBricksPerSlot);
+  p.brick = glm::uvec4(mOverlap, mReach, frame.octree.levels, layout.subBricksPerSlot);
   p.pool = glm::uvec4(layout.mipWordsPerSlot, layout.attributes ? 1u : 0u, std::uint32_t(frame.bricks.size()),
                       layout.mipLevels);
-  p.sphere = glm::vec4(mSettings.radius, mSettings.jitter, 0.0f, 0.0f);
+  p.sphere = glm::vec4(mSettings.radius, mSettings.jitter, 0.0f, mSettings.thicknessSaturationCells);
+  const FoamSettings& foam = mSettings.foam;
+  p.foam = glm::uvec4(foam.mode == FoamMode::Keep     ? 0u
+                      : foam.mode == FoamMode::Remove ? kFoamSkip
+                                                      : kFoamSkip | kFoamVolume,
+                      0u, 0u, 0u);
+  p.volume = glm::vec4(foam.step, foam.extinction, foam.opacityStop, 0.0f);
   FLIPSCOPE_CHECK(layout.mipLevels <= kMaxMipLevels, "mip levels " << layout.mipLevels);
   for (std::uint32_t level = 1; level <= layout.mipLevels; ++level)
-    p.mipLevels[level - 1] =
-        glm::uvec4(bitBrickMipDims(level, h.brickSize, mReach), bitBrickMipWordOffset(level, h.brickSize, mReach));
+    p.mipLevels[level - 1] = glm::uvec4(bitBrickMipDims(level, h.brickSize, mOverlap),
+                                        bitBrickMipWordOffset(level, h.brickSize, mOverlap));
+  return p;
+}
+
+FoamClassifyParams FrameRenderer::foamParams(std::size_t slots) const {
+  const PoolLayout& layout = mPool.layout();
+  FoamClassifyParams p{};
+  p.brick = glm::uvec4(layout.brickSize, mOverlap, layout.subBricksPerSlot,
+                       std::uint32_t(slots * layout.subBricksPerSlot));
+  p.sphere = glm::vec4(mSettings.radius, mSettings.foam.threshold, mSettings.foam.classifies() ? 1.0f : 0.0f, 0.0f);
   return p;
 }
 
@@ -210,6 +239,7 @@ RenderStats FrameRenderer::trace(int frame, const Camera& camera, int direction)
       return da != db ? da < db : wanted.at(a->key) < wanted.at(b->key);
     });
     const std::uint64_t batch = ++mBatch;
+    std::vector<std::uint32_t> uploadedSlots;
     for (const auto& brick : bricks) {
       evicted.clear();
       const auto placement = mPool.place(brick->key, brick->bits.attributes.size(), batch, evicted);
@@ -225,10 +255,17 @@ RenderStats FrameRenderer::trace(int frame, const Camera& camera, int direction)
       if (!placement) break;  // the pool holds this pass's bricks only: the rest next pass
       mDevice->uploadBrick(placement->slot, placement->attributeOffset, *brick);
       pages[wanted.at(brick->key)] = placement->slot;
+      uploadedSlots.push_back(placement->slot);
       ++stats.bricksUploaded;
     }
     mDevice->setPageTable(pages);
     stats.uploadMs += msSince(uploadStart);
+    // §3.5: the bricks uploaded in this pass are classified in one batch before the next trace.
+    if (mSettings.foam.classifies() && !uploadedSlots.empty()) {
+      mDevice->classifyFoam(uploadedSlots, foamParams(uploadedSlots.size()));
+      stats.foamMs += mDevice->lastClassifyMs();
+      stats.bricksClassified += uploadedSlots.size();
+    }
   }
   stats.bricksResident = mPool.resident();
   stats.totalMs = msSince(start);

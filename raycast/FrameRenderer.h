@@ -22,6 +22,7 @@
 #include "preprocess/store/BrickStore.h"
 #include "raycast/BrickPool.h"
 #include "raycast/Camera.h"
+#include "raycast/FoamSettings.h"
 #include "raycast/RaycastDevice.h"
 #include "streaming/BrickSource.h"
 #include "streaming/Streamer.h"
@@ -38,11 +39,20 @@ struct RenderSettings {
   unsigned threads = 0;                                   ///< conversion workers; 0: all cores
   int maxPasses = 1000;
   int readAheadFrames = 0;
+  FoamSettings foam;  ///< §3.5
+  /// Liquid cells at which the thickness trace behind a hit stops, absorption having saturated
+  /// (§3.6; FramePipeline derives it from the shading's absorption); 0: no thickness.
+  float thicknessSaturationCells = 64.0f;
 };
 /// Throws InputError naming the setting that is out of range.
 void validate(const RenderSettings& settings);
 /// Cells around a cell whose spheres can reach it: ceil(radius + jitter + 0.5) - 1.
 std::uint32_t sphereReach(float radius, float jitter);
+/// The overlap border the pool's bricks are converted with: the sphere reach, and with foam
+/// enough that every cell the ray-caster reads is classified from its whole neighbourhood (reach
+/// + the radius; 6 for the volume's trilinear 4^3 blocks), at most kMaxOverlap (beyond it a
+/// cell near a brick face sees only the neighbours within the border).
+std::uint32_t storedOverlap(const RenderSettings& settings);
 /// The sphere radius in cells a render takes when none is given: kDefaultRadiusPerSpacing particle
 /// spacings of the store (StoreHeader::particleSpacing), so the spheres of neighbouring particles
 /// overlap and a liquid body renders closed even where a FLIP sheet is one or two particles
@@ -59,12 +69,14 @@ struct RenderStats {
   std::uint64_t bricksRequested = 0;  ///< summed over passes
   std::uint64_t bricksUploaded = 0;
   std::uint64_t bricksEvicted = 0;
+  std::uint64_t bricksClassified = 0;  ///< foam classification (§3.5), of uploaded bricks
   std::size_t bricksResident = 0;  ///< in the pool after the frame, all frames
   std::size_t frameBricks = 0;     ///< non-empty bricks of the frame
   std::uint64_t poolBytes = 0;     ///< device memory of the brick pool
   double traceMs = 0;              ///< device time of the passes (GL timer queries on the GPU)
   double streamMs = 0;             ///< waiting for the Streamer (conversion or CPU cache)
   double uploadMs = 0;
+  double foamMs = 0;  ///< foam classification on the device
   double totalMs = 0;
 };
 
@@ -102,6 +114,8 @@ class FrameRenderer {
   Box occupiedBounds(int frame) const { return occupiedBounds(frame, frame); }
   /// The parameter block of a pass (exposed for tests).
   RaycastParams params(const Camera& camera, const FrameIndex& frame) const;
+  /// The foam classification block for a batch of `slots` uploaded bricks (exposed for tests).
+  FoamClassifyParams foamParams(std::size_t slots) const;
 
  private:
   std::vector<std::uint32_t> pageTable(const FrameIndex& frame) const;
@@ -110,6 +124,7 @@ class FrameRenderer {
   std::unique_ptr<RaycastDevice> mDevice;
   RenderSettings mSettings;
   std::uint32_t mReach = 0;
+  std::uint32_t mOverlap = 0;
   BrickPool mPool;
   std::unique_ptr<Streamer> mStreamer;
   std::uint64_t mBatch = 0;

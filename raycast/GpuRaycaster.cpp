@@ -23,9 +23,12 @@ enum Binding : GLuint {
   kAttributes = 6,
   kHits = 7,
   kRequests = 8,
-  kRequestFlags = 9
+  kRequestFlags = 9,
+  kFoam = 10,
+  kBatch = 11,  // FoamClassify.comp: the batch's slots
 };
-constexpr std::uint32_t kGroupSize = 8;  // local_size_x and _y of Raycast.comp
+constexpr std::uint32_t kGroupSize = 8;      // local_size_x and _y of Raycast.comp
+constexpr std::uint32_t kFoamGroupSize = 64;  // local_size_x of FoamClassify.comp
 
 /// A buffer of at least `bytes` (GL refuses empty storage; unused bindings get 16 bytes).
 /// Data shorter than 16 bytes is copied into a zeroed block first: GL reads the whole storage
@@ -48,6 +51,7 @@ GpuRaycaster::GpuRaycaster()
   const std::string renderer = mContext.renderer();
   mSoftware = renderer.find("llvmpipe") != std::string::npos || renderer.find("softpipe") != std::string::npos;
   mParams = makeBuffer(sizeof(RaycastParams));
+  mFoam = makeBuffer(0);  // bound by every trace; a pool without foam never reads it
 }
 
 GpuRaycaster::~GpuRaycaster() = default;
@@ -60,6 +64,7 @@ void GpuRaycaster::allocatePool(const PoolLayout& layout) {
   mMips = makeBuffer(std::uint64_t(layout.slots) * layout.mipWordsPerSlot * 4);
   mAttributeBases = makeBuffer(layout.attributes ? std::uint64_t(layout.slots) * layout.subBricksPerSlot * 4 : 0);
   mAttributes = makeBuffer(layout.attributeCapacity * 2);
+  mFoam = makeBuffer(layout.foam ? std::uint64_t(layout.slots) * layout.subBricksPerSlot * 16 : 0);
 }
 
 void GpuRaycaster::setOctree(std::span<const OctreeNode> nodes) {
@@ -89,6 +94,41 @@ void GpuRaycaster::uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset
     if (!brick.bits.attributes.empty())
       mAttributes.upload(attributeOffset * 2, brick.bits.attributes.data(), brick.bits.attributes.size() * 2);
   }
+  if (mLayout.foam) {
+    const std::uint64_t offset = std::uint64_t(slot) * mLayout.subBricksPerSlot * 16;
+    if (brick.foamKinds.empty()) {
+      mFoam.clearZero(offset, std::uint64_t(mLayout.subBricksPerSlot) * 16);
+    } else {
+      FLIPSCOPE_CHECK(brick.foamKinds.size() == mLayout.subBricksPerSlot);
+      mFoam.upload(offset, brick.foamKinds.data(), brick.foamKinds.size() * 16);
+    }
+  }
+}
+
+void GpuRaycaster::classifyFoam(std::span<const std::uint32_t> slots, const FoamClassifyParams& params) {
+  FLIPSCOPE_CHECK(mLayout.foam && params.brick.z == mLayout.subBricksPerSlot &&
+                  params.brick.w == slots.size() * mLayout.subBricksPerSlot);
+  mLastClassifyMs = 0;
+  if (slots.empty()) return;
+  if (!mFoamProgram.id()) mFoamProgram = gl::Program::compute(gl::shaderSource("FoamClassify.comp"));
+  if (!mFoamParams.id()) mFoamParams = makeBuffer(sizeof(FoamClassifyParams));
+  mFoamParams.upload(0, &params, sizeof(params));
+  if (mBatch.size() < slots.size_bytes()) mBatch = makeBuffer(std::max<std::uint64_t>(slots.size_bytes(), 4096));
+  mBatch.upload(0, slots.data(), slots.size_bytes());
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  mFoamParams.bindBase(GL_UNIFORM_BUFFER, kParams);
+  mSubBricks.bindBase(GL_SHADER_STORAGE_BUFFER, kSubBricks);
+  mFoam.bindBase(GL_SHADER_STORAGE_BUFFER, kFoam);
+  mBatch.bindBase(GL_SHADER_STORAGE_BUFFER, kBatch);
+  mFoamProgram.use();
+  const auto start = std::chrono::steady_clock::now();
+  mTimer.begin();
+  mFoamProgram.dispatch((params.brick.w + kFoamGroupSize - 1) / kFoamGroupSize, 1, 1);
+  mTimer.end();
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  if (mSoftware) glFinish();
+  mLastClassifyMs = mSoftware ? std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()
+                              : mTimer.milliseconds();
 }
 
 void GpuRaycaster::beginImage(std::uint32_t width, std::uint32_t height) {
@@ -115,6 +155,7 @@ std::vector<std::uint32_t> GpuRaycaster::trace(const RaycastParams& params) {
   mHits.bindBase(GL_SHADER_STORAGE_BUFFER, kHits);
   mRequests.bindBase(GL_SHADER_STORAGE_BUFFER, kRequests);
   mRequestFlags.bindBase(GL_SHADER_STORAGE_BUFFER, kRequestFlags);
+  mFoam.bindBase(GL_SHADER_STORAGE_BUFFER, kFoam);
   mProgram.use();
   const auto start = std::chrono::steady_clock::now();
   mTimer.begin();

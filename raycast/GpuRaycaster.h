@@ -1,5 +1,5 @@
-// GpuRaycaster: the compute ray-caster on OpenGL 4.5 (raycast/glsl/Raycast.comp) with its brick
-// pool in shader storage buffers (Reichl et al. 2014 §3.3, §4.1). Headless through EGL: the
+// GpuRaycaster: the compute ray-caster on OpenGL 4.5 (raycast/glsl/Raycast.comp) and the foam
+// classification (raycast/glsl/FoamClassify.comp), with its brick pool in shader storage buffers (Reichl et al. 2014 §3.3, §4.1). Headless through EGL: the
 // NVIDIA device platform on GPU machines, Mesa (llvmpipe) elsewhere.
 #pragma once
 
@@ -26,6 +26,8 @@ class GpuRaycaster : public RaycastDevice {
   void setOctree(std::span<const OctreeNode> nodes) override;
   void setPageTable(std::span<const std::uint32_t> pageTable) override;
   void uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset, const ConvertedBrick& brick) override;
+  void classifyFoam(std::span<const std::uint32_t> slots, const FoamClassifyParams& params) override;
+  double lastClassifyMs() const override { return mLastClassifyMs; }
   void beginImage(std::uint32_t width, std::uint32_t height) override;
   std::vector<std::uint32_t> trace(const RaycastParams& params) override;
   double lastTraceMs() const override { return mLastTraceMs; }
@@ -37,13 +39,16 @@ class GpuRaycaster : public RaycastDevice {
  private:
   gl::EglContext mContext;
   gl::Program mProgram;
+  gl::Program mFoamProgram;  ///< raycast/glsl/FoamClassify.comp, compiled on first use
   gl::TimerQuery mTimer;
   std::uint64_t mMaxBufferBytes = 0;
   PoolLayout mLayout;
   std::uint32_t mWidth = 0, mHeight = 0;
   std::size_t mBricks = 0;  ///< bricks of the current frame (page table entries)
   gl::Buffer mParams, mNodes, mPages, mSubBricks, mMips, mAttributeBases, mAttributes, mHits, mRequests, mRequestFlags;
+  gl::Buffer mFoam, mFoamParams, mBatch;
   double mLastTraceMs = 0;
+  double mLastClassifyMs = 0;
   bool mSoftware = false;  ///< Mesa llvmpipe/softpipe: timer queries return ~0, passes are timed on the wall clock
 };
 

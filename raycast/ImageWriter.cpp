@@ -25,6 +25,7 @@ namespace {
 constexpr const char* kNormalChannels[3] = {"N.X", "N.Y", "N.Z"};
 constexpr const char* kUnsmoothedDepthChannel = "unsmoothed.Z";
 constexpr const char* kThicknessChannel = "thickness";
+constexpr const char* kFoamChannels[4] = {"foam.R", "foam.G", "foam.B", "foam.A"};
 
 std::size_t pixelCount(const RenderImage& image) { return std::size_t(image.width) * image.height; }
 
@@ -42,12 +43,14 @@ void checkImage(const RenderImage& image) {
                   "thickness=" << image.thickness.size() << " pixels=" << n);
   FLIPSCOPE_CHECK(image.attribute.empty() || image.attribute.size() == n,
                   "attribute=" << image.attribute.size() << " pixels=" << n);
+  FLIPSCOPE_CHECK(image.foam.empty() || image.foam.size() == n, "foam=" << image.foam.size() << " pixels=" << n);
 }
 
 /// Every channel writeExr writes besides an attribute's.
 bool isImageChannel(const std::string& name) {
   for (const char* channel : {"R", "G", "B", "A", "Z", kUnsmoothedDepthChannel, kThicknessChannel, kNormalChannels[0],
-                              kNormalChannels[1], kNormalChannels[2]})
+                              kNormalChannels[1], kNormalChannels[2], kFoamChannels[0], kFoamChannels[1],
+                              kFoamChannels[2], kFoamChannels[3]})
     if (name == channel) return true;
   return false;
 }
@@ -126,19 +129,27 @@ void writeExr(const std::filesystem::path& path, const RenderImage& image) {
   checkImage(image);
   const std::size_t n = pixelCount(image);
   const std::size_t width = image.width;
-  std::vector<Imath::half> rgba(4 * n);
-  for (std::size_t i = 0; i < n; ++i)
-    for (int c = 0; c < 4; ++c) rgba[4 * i + c] = Imath::half(image.rgba[i][c]);
 
   Imf::Header header(int(image.width), int(image.height));
   header.compression() = Imf::ZIP_COMPRESSION;
   Imf::FrameBuffer frame;
+  // Four HALF channels from a vec4 image, converted into `storage` (kept alive until written).
+  auto insertHalf4 = [&](const char* const (&names)[4], const std::vector<glm::vec4>& values,
+                         std::vector<Imath::half>& storage) {
+    if (values.empty()) return;
+    storage.resize(4 * n);
+    for (std::size_t i = 0; i < n; ++i)
+      for (int c = 0; c < 4; ++c) storage[4 * i + c] = Imath::half(values[i][c]);
+    for (int c = 0; c < 4; ++c) {
+      header.channels().insert(names[c], Imf::Channel(Imf::HALF));
+      frame.insert(names[c], Imf::Slice(Imf::HALF, reinterpret_cast<char*>(storage.data() + c),
+                                        4 * sizeof(Imath::half), 4 * sizeof(Imath::half) * width));
+    }
+  };
   constexpr const char* kRgba[4] = {"R", "G", "B", "A"};
-  for (int c = 0; c < 4; ++c) {
-    header.channels().insert(kRgba[c], Imf::Channel(Imf::HALF));
-    frame.insert(kRgba[c], Imf::Slice(Imf::HALF, reinterpret_cast<char*>(rgba.data() + c), 4 * sizeof(Imath::half),
-                                      4 * sizeof(Imath::half) * width));
-  }
+  std::vector<Imath::half> rgba, foam;
+  insertHalf4(kRgba, image.rgba, rgba);
+  insertHalf4(kFoamChannels, image.foam, foam);
   auto insertFloat = [&](const char* name, const std::vector<float>& values) {
     if (values.empty()) return;
     header.channels().insert(name, Imf::Channel(Imf::FLOAT));
@@ -248,6 +259,11 @@ ExrContents readExr(const std::filesystem::path& path) {
     readFloat("Z", image.depth);
     readFloat(kUnsmoothedDepthChannel, image.unsmoothedDepth);
     readFloat(kThicknessChannel, image.thickness);
+    if (has(kFoamChannels[0]) && has(kFoamChannels[1]) && has(kFoamChannels[2]) && has(kFoamChannels[3])) {
+      image.foam.assign(n, glm::vec4(0.0f));
+      for (int c = 0; c < 4; ++c)
+        frame.insert(kFoamChannels[c], Imf::Slice::Make(Imf::FLOAT, &image.foam[0][c], window, sizeof(glm::vec4)));
+    }
     if (has(kNormalChannels[0]) && has(kNormalChannels[1]) && has(kNormalChannels[2])) {
       image.normal.assign(n, glm::vec3(0.0f));
       for (int c = 0; c < 3; ++c)

@@ -7,7 +7,8 @@
 // before smoothing), thickness (FLOAT, liquid along the ray behind the surface, world units),
 // N.X N.Y N.Z (FLOAT, world-space normal, 0 where nothing was hit) and, when the store has a
 // per-particle attribute, a FLOAT channel named after it (speed, pscale, ...: its value at the
-// surface, 0 where nothing was hit; see attributeChannel). The normal is a layer "N" in the
+// surface, 0 where nothing was hit; see attributeChannel) and, with volumetric foam, the layer
+// foam (foam.R foam.G foam.B foam.A, HALF: its premultiplied colour and opacity). The normal is a layer "N" in the
 // OpenEXR "layer.channel" naming: Nuke splits at the first '.', shows layer N with channels X, Y,
 // Z (only R/G/B/A suffixes are renamed to red/green/blue/alpha), and sorts them in x, y, z order;
 // Houdini's EXR reader groups the N.* channels into one vector plane N; OpenImageIO keeps X, Y, Z
@@ -34,6 +35,9 @@ struct RenderImage {
   std::vector<glm::vec3> normal;  ///< world-space unit normal, 0 where nothing was hit; empty or width * height
   std::vector<float> unsmoothedDepth;  ///< like depth, before smoothing; empty or width * height
   std::vector<float> thickness;        ///< world units, 0 where nothing was hit; empty or width * height
+  /// The volumetric foam (§3.5) composited into rgba: its colour premultiplied by its opacity,
+  /// and the opacity; empty or width * height. EXR layer foam (foam.R foam.G foam.B foam.A, HALF).
+  std::vector<glm::vec4> foam;
   /// The per-particle attribute of the store at each pixel (its units, 0 where nothing was hit),
   /// empty or width * height, in the EXR channel attributeChannel(attributeName).
   std::vector<float> attribute;
@@ -41,11 +45,11 @@ struct RenderImage {
 };
 
 /// The EXR channel of an attribute: its name, or "attribute.<name>" when the name is one of the
-/// channels writeExr writes anyway (R, G, B, A, Z, unsmoothed.Z, thickness, N.X, N.Y, N.Z) or empty.
+/// channels writeExr writes anyway (R, G, B, A, Z, unsmoothed.Z, thickness, N.X, N.Y, N.Z, foam.*) or empty.
 std::string attributeChannel(const std::string& attributeName);
 
-/// Writes R G B A (HALF), Z, unsmoothed.Z, thickness, N.X N.Y N.Z and the attribute (FLOAT; each
-/// only when its vector is not empty),
+/// Writes R G B A (HALF), Z, unsmoothed.Z, thickness, N.X N.Y N.Z and the attribute (FLOAT), and
+/// foam.R foam.G foam.B foam.A (HALF), each only when its vector is not empty,
 /// ZIP compressed. Throws FileError naming `path`.
 void writeExr(const std::filesystem::path& path, const RenderImage& image);
 
@@ -62,7 +66,7 @@ void writeImage(const std::filesystem::path& path, const RenderImage& image);
 
 /// What readExr found: every channel name of the file (in the file's, alphabetical, order) and
 /// the image. Missing R, G, B read as 0 and a missing A as 1; depth and normal stay empty
-/// unless the file has Z, or N.X, N.Y and N.Z; unsmoothedDepth and thickness likewise. Every
+/// unless the file has Z, or N.X, N.Y and N.Z; unsmoothedDepth, thickness and foam likewise. Every
 /// other channel (an attribute's) is read as FLOAT into `others`, by name.
 struct ExrContents {
   std::vector<std::string> channels;

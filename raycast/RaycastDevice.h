@@ -11,6 +11,7 @@
 
 #include "preprocess/store/PresenceOctree.h"
 #include "raycast/BrickPool.h"
+#include "raycast/FoamTypes.h"
 #include "raycast/RaycastTypes.h"
 #include "streaming/ConvertedBrickCache.h"
 
@@ -30,7 +31,14 @@ class RaycastDevice {
   virtual void setOctree(std::span<const OctreeNode> nodes) = 0;
   virtual void setPageTable(std::span<const std::uint32_t> pageTable) = 0;
   /// Writes a converted brick into `slot`; its attributes go to ring entries from `attributeOffset`.
+  /// With a foam pool (PoolLayout::foam) its foam bit-brick becomes brick.foamKinds, or zeros.
   virtual void uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset, const ConvertedBrick& brick) = 0;
+  /// Foam classification (§3.5, raycast/glsl/FoamClassify.glsl) of the bricks uploaded into
+  /// `slots`: their foam bit-bricks become the uploaded ones plus the classified cells. Needs a
+  /// foam pool; params.brick.w must be slots.size() * the sub-bricks per slot.
+  virtual void classifyFoam(std::span<const std::uint32_t> slots, const FoamClassifyParams& params) = 0;
+  /// Milliseconds the last classifyFoam() took (as lastTraceMs).
+  virtual double lastClassifyMs() const = 0;
   /// Starts an image: every ray fresh (a zeroed RayHit: pending at t = 0).
   virtual void beginImage(std::uint32_t width, std::uint32_t height) = 0;
   /// One pass over the pending rays. Returns the brick indices that rays stopped at, ascending

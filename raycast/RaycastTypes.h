@@ -16,17 +16,21 @@ using glsl::kNotResident;
 using glsl::kRayHit;
 using glsl::kRayMiss;
 using glsl::kRayPending;
-using glsl::kThicknessCells;
+using glsl::kFoamSkip;
+using glsl::kFoamVolume;
+using glsl::kThicknessMaxCells;
 using glsl::RaycastParams;
 using glsl::RayHit;
 
 // std140 and std430 agree with C++ for these members (16-byte vectors, then 4-byte scalars).
-static_assert(sizeof(RaycastParams) == 17 * 16);
+static_assert(sizeof(RaycastParams) == 19 * 16);
 static_assert(offsetof(RaycastParams, image) == 64 && offsetof(RaycastParams, sphere) == 128 &&
-              offsetof(RaycastParams, mipLevels) == 144);
+              offsetof(RaycastParams, foam) == 144 &&
+              offsetof(RaycastParams, volume) == 160 && offsetof(RaycastParams, mipLevels) == 176);
 static_assert(sizeof(RayHit) == 48 && sizeof(RayHit) % sizeof(glm::vec4) == 0, "a RayHit is three vec4 (pipeline/glsl)");
 static_assert(kRayPending == 0, "a zeroed RayHit is a fresh pending ray");
 static_assert(offsetof(RayHit, t) == 16 && offsetof(RayHit, status) == 20 && offsetof(RayHit, depth) == 24 &&
-              offsetof(RayHit, brickIndex) == 28 && offsetof(RayHit, thickness) == 32);
+              offsetof(RayHit, brickIndex) == 28 && offsetof(RayHit, thickness) == 32 &&
+              offsetof(RayHit, foam) == 36);
 
 }  // namespace flipscope

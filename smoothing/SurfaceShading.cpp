@@ -12,10 +12,10 @@ namespace flipscope {
 namespace glsl {
 #include "smoothing/glsl/ColorMap.glsl"
 #include "smoothing/glsl/ShadingTypes.glsl"
-static_assert(sizeof(ShadingParams) == 7 * 16 && offsetof(ShadingParams, mode) == 64 &&
-              offsetof(ShadingParams, colorMap) == 76 && offsetof(ShadingParams, fresnelF0) == 80 &&
-              offsetof(ShadingParams, shininess) == 92 && offsetof(ShadingParams, colorBy) == 96 &&
-              offsetof(ShadingParams, attributeOffset) == 108);
+static_assert(sizeof(ShadingParams) == 8 * 16 && offsetof(ShadingParams, foamColour) == 64 &&
+              offsetof(ShadingParams, mode) == 80 && offsetof(ShadingParams, colorMap) == 92 &&
+              offsetof(ShadingParams, fresnelF0) == 96 && offsetof(ShadingParams, shininess) == 108 &&
+              offsetof(ShadingParams, colorBy) == 112 && offsetof(ShadingParams, attributeOffset) == 124);
 static_assert(kColorMapCount == 4u && kColorMapBlues == std::uint32_t(ColorMap::Blues));
 
 struct ShadingKernel : CpuScreenKernel {
@@ -82,6 +82,7 @@ void SurfaceShading::shade(ScreenDevice& device, ScreenImage gbuffer, ScreenImag
   p.absorption = glm::vec4(mOptions.absorption, 0);
   p.liquidColour = glm::vec4(mOptions.liquidColour, 0);
   p.albedo = glm::vec4(mOptions.albedo, 0);
+  p.foamColour = glm::vec4(mOptions.foamColour, mOptions.foam && mOptions.mode != ShadingMode::Normals ? 1.0f : 0.0f);
   p.colorBy = mOptions.colorByAttribute ? 1u : 0u;
   p.colorMap = std::uint32_t(mOptions.colorMap);
   // t = (value - A) / (B - A), value = frameMin + w (frameMax - frameMin).

@@ -52,6 +52,8 @@ struct ShadingOptions {
   glm::vec3 absorption{0.30f, 0.11f, 0.06f};         ///< Beer-Lambert per cell of liquid (RGB)
   glm::vec3 liquidColour{0.03f, 0.17f, 0.28f};       ///< light scattered in deep liquid
   glm::vec3 albedo{0.05f, 0.26f, 0.55f};             ///< spheres and lit surface without colour by attribute
+  bool foam = false;                                 ///< composite the volumetric foam (sphere normals' w)
+  glm::vec3 foamColour{0.90f, 0.93f, 0.95f};         ///< §3.5
   float fresnelF0 = 0.02f;                            ///< water
   float refraction = 12.0f;                           ///< pixels of background offset per unit tilt
   float specular = 0.45f;
@@ -60,7 +62,7 @@ struct ShadingOptions {
 
 /// Shades into `output` (linear RGB, alpha 1) from the G-buffer `gbuffer` (x: unsmoothed depth,
 /// y: mask, z: thickness in world units, w: attribute), the smoothed `normals` and the hits'
-/// `sphereNormals`. `environment` is a fixed image holding `map` (unused when map is empty).
+/// `sphereNormals` (w: the volumetric foam's opacity, composited last with options.foam). `environment` is a fixed image holding `map` (unused when map is empty).
 /// The light follows the camera: `right`, `up`, `forward` are the frame's axes.
 class SurfaceShading {
  public:

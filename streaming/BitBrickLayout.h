@@ -12,6 +12,7 @@ namespace flipscope {
 using glsl::bitBrickAttributeOffset;
 using glsl::bitBrickBitIndex;
 using glsl::bitBrickBitSet;
+using glsl::bitBrickHalfCount;
 using glsl::bitBrickMipBitIndex;
 using glsl::bitBrickMipDims;
 using glsl::bitBrickMipLevelCount;

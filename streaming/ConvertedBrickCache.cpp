@@ -40,6 +40,7 @@ std::vector<std::byte> compressConvertedBrick(const ConvertedBrick& brick, int z
   putVector(raw, brick.bits.subBrickOffsets);
   putVector(raw, brick.bits.attributes);
   putVector(raw, brick.mipmap);
+  putVector(raw, brick.foamKinds);
   std::vector<std::byte> out(sizeof(std::uint64_t) + ZSTD_compressBound(raw.size()));
   std::uint64_t rawSize = raw.size();
   std::memcpy(out.data(), &rawSize, sizeof(rawSize));
@@ -69,6 +70,7 @@ ConvertedBrick decompressConvertedBrick(std::span<const std::byte> bytes) {
   getVector(in, brick.bits.subBrickOffsets, "sub-brick offsets");
   getVector(in, brick.bits.attributes, "attributes");
   getVector(in, brick.mipmap, "mipmap");
+  getVector(in, brick.foamKinds, "foam kinds");
   in.expectEnd("converted brick");
   return brick;
 }

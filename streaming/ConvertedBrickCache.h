@@ -14,12 +14,15 @@
 
 namespace flipscope {
 
-/// A brick ready for upload: bits, attributes and mipmap (streaming/glsl/BitBrick.glsl layouts).
+/// A brick ready for upload: bits, attributes and mipmap (streaming/glsl/BitBrick.glsl layouts),
+/// and the cells whose stored kind counts as foam, in the layout of bits.subBricks (empty when
+/// none does: the store has no kinds, or they are not wanted).
 struct ConvertedBrick {
   BrickKey key;
   BitBrick bits;
   std::vector<std::uint32_t> mipmap;
-  std::size_t bytes() const { return bits.bytes() + mipmap.size() * 4; }
+  std::vector<glm::uvec4> foamKinds;
+  std::size_t bytes() const { return bits.bytes() + mipmap.size() * 4 + foamKinds.size() * 16; }
 };
 
 /// In-memory serialization used by the compressed cache (not a file format).

@@ -7,6 +7,8 @@
 //   uint  rcPage(uint brickIndex)                 pool slot of a brick of the frame, or kNotResident
 //   uvec4 rcSubBrick(uint slot, uint subBrick)    bits of a resident brick
 //   uint  rcMipWord(uint slot, uint word)         its occupancy mipmap (BrickMipmap.h layout)
+//   uvec4 rcFoamSubBrick(uint slot, uint subBrick)  its foam bit-brick (FoamClassify.glsl), read
+//                                                 only with kFoamSkip
 //   uint  rcAttributeBase(uint slot, uint subBrick)  attribute index of the sub-brick's first set cell
 //   uint  rcAttribute(uint index)                 16-bit attribute value
 //   void  rcRequest(uint brickIndex)              asks for a brick (deduplicated by the includer)
@@ -25,6 +27,13 @@
 //     otherwise the spheres of the (2k+1)^3 cells around the point's cell are tested (those
 //     not tested at the previous cell), and once the nearest hit so far lies no farther than
 //     the cell's exit it ends the ray (a nearer hit would have been found in an earlier cell).
+//
+// Foam (§3.5). With kFoamSkip the cells of the slot's foam bit-brick are no spheres (`--foam
+// remove` and `volume`). With kFoamVolume the ray also accumulates the foam in front of its hit
+// (or along its whole way through the bricks) at fixed steps, emission-absorption over a density
+// interpolated trilinearly between the 4^3 halves of the foam sub-bricks (Fig. 7); it ends as a
+// miss once the foam's opacity reaches P.volume.z. Regions a clear mip block skips hold no set
+// cell within the dilation, and no foam is gathered there.
 
 // A small step past a box exit, so that point location lands in the next box.
 FS_FUNC float rcStepPast(float t) { return t + 1.0e-3f + abs(t) * 4.0e-7f; }
@@ -56,12 +65,68 @@ FS_FUNC vec3 rcCameraRay(uvec2 pixel) {
   return normalize(f + sx * r + sy * u);
 }
 
-FS_FUNC bool rcCellSet(uint slot, ivec3 cell) {
+// Whether brick-local `cell` holds a sphere: set, and not foam when the pool's foam bit-bricks
+// are valid (kFoamSkip; §3.5: the surface pass skips foam cells).
+FS_FUNC bool rcSurfaceCellSet(uint slot, ivec3 cell) {
   uint overlap = P.brick.x;
-  uint brickSize = P.grid.w;
-  uvec4 bits = rcSubBrick(slot, bitBrickSubBrickIndex(cell, brickSize, overlap));
+  uint subBrick = bitBrickSubBrickIndex(cell, P.grid.w, overlap);
+  uvec4 bits = rcSubBrick(slot, subBrick);
+  if ((P.foam.x & kFoamSkip) != 0u) bits = bits & ~rcFoamSubBrick(slot, subBrick);
   return bitBrickBitSet(bits, bitBrickBitIndex(cell, overlap));
 }
+
+// The 4^3 block `block` of a slot's stored cells (block b spans stored cells [4b, 4b + 4), the
+// halves of the sub-bricks; clamped to the stored blocks): x its sub-brick, y which half.
+FS_FUNC uvec2 rcHalfBlock(ivec3 block) {
+  uvec3 dims = bitBrickSubBrickDims(P.grid.w, P.brick.x);
+  ivec3 b = clamp(block, ivec3(0), ivec3(int(dims.x) - 1, int(dims.y) - 1, int(2u * dims.z) - 1));
+  return uvec2(uint(b.x) + dims.x * (uint(b.y) + dims.y * (uint(b.z) >> 1u)), uint(b.z) & 1u);
+}
+
+// Density (0..1) of the sphere cells in the 4^3 block holding brick-local point `p` (§3.6).
+FS_FUNC float rcLiquidDensity(uint slot, vec3 p) {
+  uvec2 h = rcHalfBlock(ivec3(floor((p + vec3(float(P.brick.x))) * 0.25f)));
+  uvec4 bits = rcSubBrick(slot, h.x);
+  if ((P.foam.x & kFoamSkip) != 0u) bits = bits & ~rcFoamSubBrick(slot, h.x);
+  return float(bitBrickHalfCount(bits, h.y)) / 64.0f;
+}
+
+// Foam density (0..1) at brick-local point `p`: trilinear between the centres of the 4^3 blocks
+// of the foam bit-brick, each block's density its set bits / 64 (§3.5, Fig. 7).
+FS_FUNC float rcFoamDensity(uint slot, vec3 p) {
+  vec3 u = (p + vec3(float(P.brick.x))) * 0.25f - vec3(0.5f);
+  vec3 f = floor(u);
+  vec3 w = u - f;
+  ivec3 b = ivec3(f);
+  float density = 0.0f;
+  for (int i = 0; i < 8; i++) {
+    ivec3 o = ivec3(i & 1, (i >> 1) & 1, i >> 2);
+    uvec2 h = rcHalfBlock(b + o);
+    float weight = (o.x == 1 ? w.x : 1.0f - w.x) * (o.y == 1 ? w.y : 1.0f - w.y) * (o.z == 1 ? w.z : 1.0f - w.z);
+    density += weight * float(bitBrickHalfCount(rcFoamSubBrick(slot, h.x), h.y));
+  }
+  return density / 64.0f;
+}
+
+// The foam opacity `opacity` after the ray segment [a, b) (cells from the eye) through the
+// resident brick at `slot` (o: the eye in brick-local cells): samples at the fixed steps
+// t_i = (i + 0.5) * P.volume.x of the whole ray, each absorbing and emitting 1 - exp(-sigma
+// density step) of what is left (§3.5). Stops once the opacity reaches P.volume.z.
+FS_FUNC float rcAccumulateFoam(float opacity, uint slot, vec3 o, vec3 dir, float a, float b) {
+  float step = P.volume.x;
+  float i = -floor(0.5f - a / step);  // the first i with t_i >= a
+  for (uint n = 0u; n < kRaycastMaxSteps && opacity < P.volume.z; n++) {
+    float t = (i + 0.5f) * step;
+    if (t >= b) break;
+    float density = rcFoamDensity(slot, o + t * dir);
+    if (density > 0.0f) opacity += (1.0f - opacity) * (1.0f - exp(-P.volume.y * density * step));
+    i += 1.0f;
+  }
+  return opacity;
+}
+
+// Whether `ray` has met foam opaque enough to end it (kFoamVolume).
+FS_FUNC bool rcFoamOpaque(RayHit ray) { return (P.foam.x & kFoamVolume) != 0u && ray.foam >= P.volume.z; }
 
 FS_FUNC float rcCellAttribute(uint slot, ivec3 cell) {
   if (P.pool.y == 0u) return 0.0f;
@@ -83,7 +148,8 @@ FS_FUNC bool rcMipClear(uint slot, uint level, ivec3 cell) {
 }
 
 // Traces the segment [t, tEnd] of the ray through resident brick `brick` (at `slot`). Returns a
-// hit in `result` (status kRayHit) or leaves result.status pending.
+// hit in `result` (status kRayHit) or leaves result.status pending; with kFoamVolume it adds the
+// foam in front of the hit (or of tEnd) to result.foam and returns as soon as rcFoamOpaque.
 FS_FUNC RayHit rcTraceBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t, float tEnd) {
   int B = int(P.grid.w);
   int k = int(P.brick.y);
@@ -126,7 +192,7 @@ FS_FUNC RayHit rcTraceBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec
           ivec3 q = cell + ivec3(dx, dy, dz);
           ivec3 seen = abs(q - previous);
           if (max(max(seen.x, seen.y), seen.z) <= k) continue;
-          if (!rcCellSet(slot, q)) continue;
+          if (!rcSurfaceCellSet(slot, q)) continue;
           vec3 centre = vec3(q) + vec3(0.5f);
           if (jitter > 0.0f) {
             uvec3 global = uvec3(ivec3(brick * uvec3(uint(B))) + q);
@@ -151,6 +217,10 @@ FS_FUNC RayHit rcTraceBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec
     }
     previous = cell;
     float cellExit = rcBoxSpan(o, invDir, vec3(cell), vec3(cell + ivec3(1))).y;
+    if ((P.foam.x & kFoamVolume) != 0u) {
+      result.foam = rcAccumulateFoam(result.foam, slot, o, dir, t, min(cellExit, best));
+      if (rcFoamOpaque(result)) return result;
+    }
     if (best <= cellExit) {
       result.normal = vec4(normalize(bestNormal), rcCellAttribute(slot, bestCell));
       result.t = best;
@@ -181,18 +251,28 @@ FS_FUNC uint rcBrickIndex(uvec3 brick) {
   return node;
 }
 
-// Thickness of the liquid behind a hit at tHit (§3.6): x = the set cells met at unit steps along
-// the ray over the next kThicknessCells cells; y = kNotResident, or the index of a brick on the
-// way that is not resident (x is then incomplete). With P.sphere.z = 1 (best effort) bricks that
-// are not resident count as empty and y is always kNotResident.
-FS_FUNC uvec2 rcThickness(vec3 eye, vec3 dir, float tHit) {
+// What rcThickness measured: the liquid in cells, and kNotResident or the index of a brick on
+// the way that is not resident (cells is then incomplete).
+struct ThicknessTrace {
+  float cells;
+  uint missingBrick;
+};
+
+// Thickness of the liquid behind a hit at tHit (§3.6: "tracing each ray through the fluid body,
+// using our proposed density calculation, until maximum absorption is reached"): the density of
+// the sphere cells (rcLiquidDensity) summed at unit steps along the ray until it reaches
+// P.sphere.w cells, after at most kThicknessMaxCells steps, or at the grid's end. With
+// P.sphere.z = 1 (best effort) bricks that are not resident count as empty.
+FS_FUNC ThicknessTrace rcThickness(vec3 eye, vec3 dir, float tHit) {
   int B = int(P.grid.w);
   ivec3 gridCells = ivec3(int(P.grid.x), int(P.grid.y), int(P.grid.z)) * B;
   bool bestEffort = P.sphere.z > 0.5f;
   ivec3 current = ivec3(-1);
   uint slot = kNotResident;
-  uint occupied = 0u;
-  for (uint i = 0u; i < kThicknessCells; i++) {
+  ThicknessTrace trace;
+  trace.cells = 0.0f;
+  trace.missingBrick = kNotResident;
+  for (uint i = 0u; i < kThicknessMaxCells && trace.cells < P.sphere.w; i++) {
     vec3 p = eye + (tHit + 0.5f + float(i)) * dir;
     ivec3 cell = ivec3(floor(p));
     if (cell.x < 0 || cell.y < 0 || cell.z < 0 || cell.x >= gridCells.x || cell.y >= gridCells.y ||
@@ -203,11 +283,14 @@ FS_FUNC uvec2 rcThickness(vec3 eye, vec3 dir, float tHit) {
       current = brick;
       uint index = rcBrickIndex(uvec3(brick));
       slot = index == kNotResident ? kNotResident : rcPage(index);
-      if (index != kNotResident && slot == kNotResident && !bestEffort) return uvec2(occupied, index);
+      if (index != kNotResident && slot == kNotResident && !bestEffort) {
+        trace.missingBrick = index;
+        return trace;
+      }
     }
-    if (slot != kNotResident && rcCellSet(slot, cell - brick * B)) occupied++;
+    if (slot != kNotResident) trace.cells += rcLiquidDensity(slot, p - vec3(brick * B));
   }
-  return uvec2(occupied, kNotResident);
+  return trace;
 }
 
 // Continues `ray` (pending, from ray.t) for `pixel` until it hits, misses, or stops at a brick
@@ -270,6 +353,10 @@ FS_FUNC RayHit rcTrace(uvec2 pixel, RayHit ray) {
     float brickExit = rcBoxSpan(eye, invDir, lo, lo + vec3(float(B))).y;
     result.status = kRayPending;
     result = rcTraceBrick(result, slot, brick, eye, dir, t, brickExit);
+    if (rcFoamOpaque(result)) {
+      result.status = kRayMiss;
+      return result;
+    }
     if (result.status == kRayHit) {
       result.brickIndex = brickIndex;
       result.depth = result.t * P.up.w * dot(dir, vec3(P.forward.x, P.forward.y, P.forward.z));
@@ -283,16 +370,18 @@ FS_FUNC RayHit rcTrace(uvec2 pixel, RayHit ray) {
 
 // Fills in the thickness of a hit `ray` (status kRayHit) for `pixel`: the bricks behind the hit
 // must be resident; a missing one is requested and the thickness stays -1 (unknown), so the
-// next pass comes back to it. The hit itself is final.
+// next pass comes back to it. The hit itself is final. P.sphere.w = 0: thickness 0 at once.
 FS_FUNC RayHit rcResolveThickness(uvec2 pixel, RayHit ray) {
   RayHit result = ray;
+  result.thickness = 0.0f;
+  if (P.sphere.w <= 0.0f) return result;
   vec3 eye = vec3(P.eye.x, P.eye.y, P.eye.z);
-  uvec2 thickness = rcThickness(eye, rcCameraRay(pixel), ray.t);
-  if (thickness.y != kNotResident) {
-    rcRequest(thickness.y);
+  ThicknessTrace trace = rcThickness(eye, rcCameraRay(pixel), ray.t);
+  if (trace.missingBrick != kNotResident) {
+    rcRequest(trace.missingBrick);
     result.thickness = -1.0f;
   } else {
-    result.thickness = float(thickness.x) * P.up.w;
+    result.thickness = trace.cells * P.up.w;
   }
   return result;
 }

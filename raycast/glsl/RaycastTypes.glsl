@@ -18,7 +18,11 @@ struct RaycastParams {
   uvec4 pool;    // x: mip words per slot; y: 1 with attributes; z: bricks in the frame; w: mip levels
   vec4 sphere;   // x: radius in cells; y: max jitter in cells; z: 1 = thickness best effort
                  // (bricks behind a hit that are not resident count as empty), 0 = request them;
-                 // w: unused
+                 // w: liquid thickness in cells at which absorption saturates: the trace behind a
+                 // hit stops there (§3.6); 0 = no thickness (a hit is final at once)
+  uvec4 foam;    // x: kFoamSkip | kFoamVolume flags (§3.5; 0: every set cell is a sphere); yzw: unused
+  vec4 volume;   // volumetric foam (§3.5): x: march step in cells; y: extinction per cell at foam
+                 // density 1; z: opacity at which the march ends the ray; w: unused
   uvec4 mipLevels[8];  // level k (1..pool.w) at k - 1: xyz blocks per axis, w word offset
 };
 
@@ -36,10 +40,12 @@ struct RayHit {
   float depth;     // linear camera depth in world units (t * cellSize * dot(dir, forward))
   uint brickIndex; // brick of the hit, or the brick a pending ray waits for (0 before the first
                    // pass), kNotResident on a miss
-  float thickness; // liquid along the ray behind the hit, world units: set cells met in the
-                   // kThicknessCells cells after it, times the cell size (§3.6); -1 while the
-                   // bricks it needs are not resident
-  float unused0;
+  float thickness; // liquid along the ray behind the hit, world units (§3.6): the density of the
+                   // surface cells (set bits of the 4^3 half sub-brick at each unit step), summed
+                   // until it reaches sphere.w cells or after kThicknessMaxCells steps, times the
+                   // cell size; -1 while the bricks it needs are not resident
+  float foam;      // opacity of the volumetric foam in front of the hit (or along a miss), 0..1
+                   // (§3.5); it accumulates while the ray is pending; 0 without kFoamVolume
   float unused1;
   float unused2;
 };
@@ -47,4 +53,6 @@ struct RayHit {
 const uint kNotResident = 0xffffffffu;
 const uint kMaxMipLevels = 8u;  // 144 stored cells (128 + 2 x 8) make 7
 const uint kRaycastMaxSteps = 65536u;  // bound on each traversal loop of one ray in one pass
-const uint kThicknessCells = 48u;      // cells behind a hit sampled for its thickness
+const uint kThicknessMaxCells = 128u;  // unit steps behind a hit at most, for its thickness
+const uint kFoamSkip = 1u;    // the pool's foam bit-bricks are valid: foam cells are no spheres
+const uint kFoamVolume = 2u;  // foam is accumulated along the ray as a volume (with kFoamSkip)

@@ -5,8 +5,10 @@
 // Shading.comp and SurfaceShading.cpp.
 //
 // Inputs: 0 G-buffer (x: unsmoothed depth, y: mask, z: thickness in world units, w: attribute),
-// 1 smoothed normals (xyz, w: mask), 2 sphere normals of the hits (xyz), 3 the equirectangular
-// environment (S.environmentWidth x S.environmentHeight, row 0 at the top) when it has one.
+// 1 smoothed normals (xyz, w: mask), 2 sphere normals of the hits (xyz) and the foam's opacity
+// (w), 3 the equirectangular environment (S.environmentWidth x S.environmentHeight, row 0 at the
+// top) when it has one. The volumetric foam in front of the surface (§3.5, Fig. 3) is composited
+// last, over the surface and the background alike: colour = foam A + shaded (1 - A).
 //
 // Colour by attribute (S.colorBy, render --color-by): one path for every mode but normals. The
 // G-buffer attribute (0..1 over the frame's range) becomes t = w * S.attributeScale +
@@ -65,14 +67,11 @@ FS_FUNC vec3 shLit(vec3 albedo, vec3 n, vec3 view) {
   return albedo * (0.22f + 0.78f * diffuse) + vec3(S.specular * highlight);
 }
 
-// shadeSurface -> linear RGB, alpha 1 (the environment behind the background).
-FS_FUNC vec4 shadeSurface(ivec2 p) {
+// The surface (or the background) of pixel p, before the foam.
+FS_FUNC vec3 shadeUnderFoam(ivec2 p) {
   vec3 ray = ssPixelRay(vec2(p) + vec2(0.5f));
   vec4 g = ssLoad(0u, p);
-  if (g.y < 0.5f) {
-    vec3 background = shEnvironment(ray);
-    return vec4(background.x, background.y, background.z, 1.0f);
-  }
+  if (g.y < 0.5f) return shEnvironment(ray);
   vec3 view = -ray;
   vec3 colour;
   if (S.mode == kShadeSpheres) {
@@ -109,6 +108,16 @@ FS_FUNC vec4 shadeSurface(ivec2 p) {
       float highlight = pow(max(dot(n, halfway), 0.0f), S.shininess) * S.specular * S.lightDirection.w;
       colour = mix(body, reflected, fresnel) + vec3(highlight);
     }
+  }
+  return colour;
+}
+
+// shadeSurface -> linear RGB, alpha 1 (the environment behind the background).
+FS_FUNC vec4 shadeSurface(ivec2 p) {
+  vec3 colour = shadeUnderFoam(p);
+  if (S.foamColour.w > 0.5f) {
+    float foam = ssLoad(2u, p).w;
+    colour = vec3(S.foamColour.x, S.foamColour.y, S.foamColour.z) * foam + colour * (1.0f - foam);
   }
   return vec4(colour.x, colour.y, colour.z, 1.0f);
 }

@@ -10,6 +10,8 @@ struct ShadingParams {
   vec4 absorption;       // xyz: Beer-Lambert coefficient per cell of liquid (RGB); w: unused
   vec4 liquidColour;     // xyz: colour of light scattered in the liquid; w: unused
   vec4 albedo;           // xyz: the spheres' and the lit surface's colour without colorBy; w: unused
+  vec4 foamColour;       // xyz: colour of the volumetric foam (§3.5), composited over the image
+                         // with the opacity of input 2's w; w: 1 = composite, 0 = no foam
   uint mode;             // kShadeLiquid, kShadeSpheres, kShadeAttribute or kShadeNormals
   uint environmentWidth;   // equirectangular map (input 3), 0: the procedural sky and ground
   uint environmentHeight;

@@ -45,6 +45,13 @@ FS_FUNC bool bitBrickBitSet(uvec4 subBrick, uint bitIndex) {
   return ((subBrick[int(bitIndex >> 5u)] >> (bitIndex & 31u)) & 1u) != 0u;
 }
 
+// Set cells of the lower (upper = 0) or upper (upper = 1) 4x4x4 half of a sub-brick: the density
+// of that block times 64 (§3.5, Fig. 7: the popcount of two words).
+FS_FUNC uint bitBrickHalfCount(uvec4 subBrick, uint upper) {
+  if (upper == 0u) return uint(bitCount(subBrick.x) + bitCount(subBrick.y));
+  return uint(bitCount(subBrick.z) + bitCount(subBrick.w));
+}
+
 // §3.2: base + countbits(v & ((1 << i) - 1)), extended over the four words of a sub-brick.
 FS_FUNC uint bitBrickAttributeOffset(uint base, uvec4 subBrick, uint bitIndex) {
   uint word = bitIndex >> 5u;

@@ -76,6 +76,7 @@ TEST_P(CpuRaycasterScenes, FindsTheNearestSphereOfABruteForce) {
   RenderSettings settings = testing::smallSettings(96, 64);
   settings.radius = seed % 2 ? 1.4f : 0.9f;
   settings.jitter = seed % 3 ? 0.3f : 0.0f;
+  settings.foam.mode = FoamMode::Keep;  // the brute force tests every sphere
   auto renderer = cpuRenderer(store, settings);
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> angle(0, 6.283);
@@ -168,7 +169,7 @@ TEST(FrameRenderer, TinyPoolConvergesByEvictionToTheSameImage) {
   BrickStore store = testing::makeStore(dir / "store", {testing::randomParticles(20000, 9, 96.0f)}, 96.0f, 32);
   RenderSettings big = testing::smallSettings();
   RenderSettings tiny = big;
-  tiny.gpuBudgetBytes = PoolLayout::forBudget(32, 1, false, 64ull << 20).slotBytes() * 3;
+  tiny.gpuBudgetBytes = PoolLayout::forBudget(32, storedOverlap(big), false, 64ull << 20, true).slotBytes() * 3;
   auto reference = cpuRenderer(store, big);
   auto starved = cpuRenderer(store, tiny);
   const Camera camera = frameOnBox(reference->occupiedBounds(0), 128.0 / 72.0);

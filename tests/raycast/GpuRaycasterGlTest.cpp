@@ -111,7 +111,7 @@ TEST(GpuRaycaster, ColdConvergesToWarmAndATinyPoolByEviction) {
   EXPECT_EQ(0, std::memcmp(cold.hits.data(), warm.hits.data(), cold.hits.size() * sizeof(RayHit)));
 
   RenderSettings tiny = settings;
-  tiny.gpuBudgetBytes = PoolLayout::forBudget(32, 1, false, 64ull << 20).slotBytes() * 3;
+  tiny.gpuBudgetBytes = PoolLayout::forBudget(32, storedOverlap(settings), false, 64ull << 20, true).slotBytes() * 3;
   GPU_RENDERER(starved, store, tiny);
   const RenderResult result = starved->render(0, camera);
   ASSERT_TRUE(result.stats.converged);

@@ -1,0 +1,64 @@
+// Foam classification (Reichl et al. 2014 §3.5): "classifying particles as foam when less than
+// 20% of the cells inside the particle radius are occupied". Shared by the compute shader
+// (raycast/glsl/FoamClassify.comp) and the CPU reference (raycast/CpuRaycaster.cpp); see
+// core/GlslShared.h. Needs BitBrick.glsl and FoamTypes.glsl before it, a FoamClassifyParams
+// named FP, and these accessors from the includer:
+//   uvec4 fcSubBrick(uint slot, uint subBrick)   bits of a resident brick (all its set cells)
+//   uvec4 fcFoam(uint slot, uint subBrick)       its foam bit-brick as uploaded: the cells whose
+//                                                stored kind counts as foam (zeros without)
+//
+// One invocation per sub-brick of a batch of freshly uploaded bricks: it reads the bits around
+// its sub-brick and returns its foam bits, which the includer writes over fcFoam of the same
+// sub-brick. An invocation writes only its own sub-brick and reads no foam bits but its own, so
+// a batch needs no atomics and no ordering. A cell's neighbourhood is every cell other than
+// itself whose centre lies within FP.sphere.x; cells beyond the stored border count as empty, so
+// a cell is classified exactly when its neighbourhood lies within the border (FrameRenderer
+// sizes the border for that).
+
+// Cells of the neighbourhood: the offsets d != 0 with |d| <= radius.
+FS_FUNC uint fcNeighbourhoodSize(float radius) {
+  int reach = int(floor(radius));
+  uint count = 0u;
+  for (int dz = -reach; dz <= reach; dz++)
+    for (int dy = -reach; dy <= reach; dy++)
+      for (int dx = -reach; dx <= reach; dx++)
+        if (float(dx * dx + dy * dy + dz * dz) <= radius * radius) count++;
+  return count - 1u;
+}
+
+// Whether stored cell `s` (brick-local cell + overlap) of `slot` is set; false beyond the stored cells.
+FS_FUNC bool fcStoredCellSet(uint slot, ivec3 s) {
+  int stored = int(FP.brick.x + 2u * FP.brick.y);
+  if (s.x < 0 || s.y < 0 || s.z < 0 || s.x >= stored || s.y >= stored || s.z >= stored) return false;
+  uvec3 dims = bitBrickSubBrickDims(FP.brick.x, FP.brick.y);
+  uvec3 u = uvec3(s);
+  uint subBrick = (u.x >> 2u) + dims.x * ((u.y >> 2u) + dims.y * (u.z >> 3u));
+  return bitBrickBitSet(fcSubBrick(slot, subBrick), (u.x & 3u) + 4u * (u.y & 3u) + 16u * (u.z & 7u));
+}
+
+// The foam bits of sub-brick `subBrick` of `slot`: the uploaded ones, plus (FP.sphere.z = 1) every
+// set cell with fewer than FP.sphere.y times fcNeighbourhoodSize set neighbours.
+FS_FUNC uvec4 fcClassify(uint slot, uint subBrick) {
+  uvec4 foam = fcFoam(slot, subBrick);
+  uvec4 bits = fcSubBrick(slot, subBrick);
+  if (FP.sphere.z < 0.5f || (bits.x | bits.y | bits.z | bits.w) == 0u) return foam;
+  float radius = FP.sphere.x;
+  int reach = int(floor(radius));
+  float needed = FP.sphere.y * float(fcNeighbourhoodSize(radius));
+  uvec3 dims = bitBrickSubBrickDims(FP.brick.x, FP.brick.y);
+  ivec3 origin = ivec3(int(subBrick % dims.x) * 4, int((subBrick / dims.x) % dims.y) * 4,
+                       int(subBrick / (dims.x * dims.y)) * 8);
+  for (uint bit = 0u; bit < 128u; bit++) {
+    if (!bitBrickBitSet(bits, bit)) continue;
+    ivec3 s = origin + ivec3(int(bit & 3u), int((bit >> 2u) & 3u), int(bit >> 4u));
+    uint count = 0u;
+    for (int dz = -reach; dz <= reach; dz++)
+      for (int dy = -reach; dy <= reach; dy++)
+        for (int dx = -reach; dx <= reach; dx++) {
+          if (float(dx * dx + dy * dy + dz * dz) > radius * radius || (dx == 0 && dy == 0 && dz == 0)) continue;
+          if (fcStoredCellSet(slot, s + ivec3(dx, dy, dz))) count++;
+        }
+    if (float(count) < needed) foam[int(bit >> 5u)] |= 1u << (bit & 31u);
+  }
+  return foam;
+}
