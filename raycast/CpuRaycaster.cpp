@@ -129,6 +129,13 @@ void CpuRaycaster::classifyFoam(std::span<const std::uint32_t> slots, const Foam
   mLastClassifyMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
+std::vector<glm::uvec4> CpuRaycaster::readFoam(std::uint32_t slot) {
+  const PoolLayout& layout = mPool.layout;
+  FLIPSCOPE_CHECK(layout.foam && slot < layout.slots);
+  const auto first = mPool.foamBits.begin() + std::size_t(slot) * layout.subBricksPerSlot;
+  return {first, first + layout.subBricksPerSlot};
+}
+
 void CpuRaycaster::beginImage(std::uint32_t width, std::uint32_t height) {
   mWidth = width;
   mHeight = height;

@@ -21,6 +21,7 @@ class CpuRaycaster : public RaycastDevice {
   void uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset, const ConvertedBrick& brick) override;
   void classifyFoam(std::span<const std::uint32_t> slots, const FoamClassifyParams& params) override;
   double lastClassifyMs() const override { return mLastClassifyMs; }
+  std::vector<glm::uvec4> readFoam(std::uint32_t slot) override;
   void beginImage(std::uint32_t width, std::uint32_t height) override;
   std::vector<std::uint32_t> trace(const RaycastParams& params) override;
   double lastTraceMs() const override { return mLastTraceMs; }

@@ -131,6 +131,14 @@ void GpuRaycaster::classifyFoam(std::span<const std::uint32_t> slots, const Foam
                               : mTimer.milliseconds();
 }
 
+std::vector<glm::uvec4> GpuRaycaster::readFoam(std::uint32_t slot) {
+  FLIPSCOPE_CHECK(mLayout.foam && slot < mLayout.slots);
+  std::vector<glm::uvec4> foam(mLayout.subBricksPerSlot);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  mFoam.download(std::uint64_t(slot) * mLayout.subBricksPerSlot * 16, foam.size() * 16, foam.data());
+  return foam;
+}
+
 void GpuRaycaster::beginImage(std::uint32_t width, std::uint32_t height) {
   mWidth = width;
   mHeight = height;

@@ -39,6 +39,8 @@ class RaycastDevice {
   virtual void classifyFoam(std::span<const std::uint32_t> slots, const FoamClassifyParams& params) = 0;
   /// Milliseconds the last classifyFoam() took (as lastTraceMs).
   virtual double lastClassifyMs() const = 0;
+  /// The foam bit-brick of `slot` of a foam pool (for tests and checks).
+  virtual std::vector<glm::uvec4> readFoam(std::uint32_t slot) = 0;
   /// Starts an image: every ray fresh (a zeroed RayHit: pending at t = 0).
   virtual void beginImage(std::uint32_t width, std::uint32_t height) = 0;
   /// One pass over the pending rays. Returns the brick indices that rays stopped at, ascending

@@ -38,6 +38,9 @@ struct RenderArgs {
   std::optional<std::string> colorRange;
   std::string environment;
   std::string jitter = "on";
+  std::string foam = "volume";
+  std::string foamFrom = "both";
+  float foamThreshold = 0.2f;
   std::string gpuMem = "1G";
   std::string cpuMem = "2G";
   std::string device = "auto";
@@ -118,6 +121,9 @@ void runRender(const RenderArgs& a) {
     job.colorByAttribute = true;  // a colour map or range asks for colour
   job.surface.environment = a.environment;
   job.settings.jitter = parseJitter(a.jitter);
+  job.settings.foam.mode = parseFoamMode(a.foam);
+  job.settings.foam.source = parseFoamSource(a.foamFrom);
+  job.settings.foam.threshold = a.foamThreshold;
   job.settings.gpuBudgetBytes = parseBytes("--gpu-mem", a.gpuMem);
   job.settings.cpuCacheBytes = parseBytes("--cpu-mem", a.cpuMem);
   job.settings.maxPasses = a.maxPasses;
@@ -141,7 +147,7 @@ void runRender(const RenderArgs& a) {
 
 void addRenderCommand(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
-  auto* cmd = app.add_subcommand("render", "Render brick store frames headless to EXR (R G B A Z N thickness) or PNG");
+  auto* cmd = app.add_subcommand("render", "Render brick store frames headless to EXR (R G B A Z N thickness foam) or PNG");
   cmd->add_option("store", args->store, "Brick store directory")->required();
   cmd->add_option("-o,--output", args->output, "Output .exr or .png; '####' takes the frame number")->required();
   auto* frame = cmd->add_option("--frame", args->frame, "Frame to render (default: the first)");
@@ -172,6 +178,17 @@ void addRenderCommand(CLI::App& app) {
                   "A,B: attribute values at the ends of the colour map (default: the store's range)");
   cmd->add_option("--env", args->environment, "Equirectangular EXR environment (default: procedural sky and ground)");
   cmd->add_option("--jitter", args->jitter, "Per-cell jitter: on (0.25 cells), off, or cells")->capture_default_str();
+  cmd->add_option("--foam", args->foam,
+                  "Foam: volume (rendered as a volume over the surface), remove (dropped, exposing the surface), "
+                  "keep (spheres like the rest)")
+      ->capture_default_str();
+  cmd->add_option("--foam-from", args->foamFrom,
+                  "What is foam: classify (cells with few neighbours), kind (the store's foam and spray particles), "
+                  "both")
+      ->capture_default_str();
+  cmd->add_option("--foam-threshold", args->foamThreshold,
+                  "A cell is foam when fewer than this fraction of the cells within the sphere radius are set (0..1)")
+      ->capture_default_str();
   cmd->add_option("--gpu-mem", args->gpuMem, "Brick pool budget on the device")->capture_default_str();
   cmd->add_option("--cpu-mem", args->cpuMem, "Converted-brick cache in CPU memory")->capture_default_str();
   cmd->add_option("--device", args->device, "auto: OpenGL through EGL, else the CPU reference; gpu; cpu")

@@ -80,6 +80,11 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
                 : store.header().particleSpacing > 0 ? " (1.5 particle spacings of the store)"
                                                      : " (the store records no particle spacing)",
                 smoothing.name.c_str(), smoothing.iterations, smoothing.strength);
+    if (settings.foam.mode == FoamMode::Keep)
+      std::printf("render: foam kept as spheres\n");
+    else
+      std::printf("render: foam %s, from %s (threshold %g)\n", foamModeName(settings.foam.mode),
+                  foamSourceName(settings.foam.source), settings.foam.threshold);
     if (surface.shading.colorByAttribute) {
       const char* map = colorMapName(surface.shading.colorMap);
       if (surface.shading.colorRange)

@@ -57,14 +57,18 @@ TEST_F(Render, WritesPngAndExrWithDepthAndNormals) {
     EXPECT_NE(std::find(contents.channels.begin(), contents.channels.end(), channel), contents.channels.end())
         << channel;
   std::size_t covered = 0;
+  ASSERT_EQ(contents.image.foam.size(), contents.image.rgba.size()) << "the default foam is a volume";
   for (std::size_t i = 0; i < contents.image.rgba.size(); ++i) {
     EXPECT_EQ(contents.image.rgba[i].a, 1.0f) << "the environment fills the background";
-    if (!std::isfinite(contents.image.depth[i])) continue;
+    if (!std::isfinite(contents.image.depth[i])) {
+      covered += contents.image.foam[i].a > 0.1f;  // foam, which has no depth
+      continue;
+    }
     ++covered;
     EXPECT_GT(contents.image.depth[i], 0.0f);
     EXPECT_NEAR(glm::length(contents.image.normal[i]), 1.0f, 1e-3f);
   }
-  EXPECT_GT(covered, 64u * 36u / 10) << "the default camera frames the fluid";
+  EXPECT_GT(covered, 64u * 36u / 10) << "the default camera frames the fluid and its foam";
 }
 
 TEST_F(Render, FlipbookAndCameraOptions) {
@@ -127,6 +131,31 @@ TEST_F(Render, SmoothingAndShadingOptionsChangeTheImage) {
   EXPECT_GT(colourChange, 0.05);
 }
 
+TEST_F(Render, FoamOptionsChangeTheImageAndTheExrHasAFoamLayer) {
+  // The synth fluid's splash holds isolated particles: a high threshold makes many cells foam.
+  const auto render = [&](const std::string& name, const std::string& options) {
+    CommandRun r = run("render " + path("store") + " -o " + path(name) + " --size 64x36 --device cpu " + options);
+    EXPECT_EQ(r.exitCode, 0) << options << "\n" << r.output;
+    return flipscope::readExr(path(name));
+  };
+  const auto volume = render("volume.exr", "--foam volume --foam-threshold 0.6");
+  const auto removed = render("remove.exr", "--foam remove --foam-threshold 0.6");
+  const auto kept = render("keep.exr", "--foam keep");
+  EXPECT_NE(std::find(volume.channels.begin(), volume.channels.end(), "foam.A"), volume.channels.end());
+  EXPECT_EQ(std::find(kept.channels.begin(), kept.channels.end(), "foam.A"), kept.channels.end());
+  double foam = 0, colourChange = 0;
+  std::size_t hitsKept = 0, hitsRemoved = 0;
+  for (std::size_t i = 0; i < kept.image.depth.size(); ++i) {
+    foam = std::max(foam, double(volume.image.foam[i].a));
+    hitsKept += std::isfinite(kept.image.depth[i]);
+    hitsRemoved += std::isfinite(removed.image.depth[i]);
+    colourChange = std::max(colourChange, double(glm::length(glm::vec3(volume.image.rgba[i] - removed.image.rgba[i]))));
+  }
+  EXPECT_GT(foam, 0.05) << "some foam is visible";
+  EXPECT_LT(hitsRemoved, hitsKept) << "removed foam leaves background where only foam was";
+  EXPECT_GT(colourChange, 0.05) << "the volume is composited over the image";
+}
+
 TEST_F(Render, BadInputsGiveClearErrors) {
   // Exit code 2: a bad option or value; 3: an unreadable or damaged file.
   const auto expectError = [&](const std::string& args, const std::string& needle, int code = 2) {
@@ -152,6 +181,10 @@ TEST_F(Render, BadInputsGiveClearErrors) {
   expectError(path("store") + " -o " + path("x.png") + " --shading glass",
               "valid values: liquid, spheres, attribute, normals");
   expectError(path("store") + " -o " + path("x.png") + " --env " + path("missing.exr"), "missing.exr", 3);
+  expectError(path("store") + " -o " + path("x.png") + " --foam bubbles", "valid values: volume, remove, keep");
+  expectError(path("store") + " -o " + path("x.png") + " --foam-from guess", "valid values: classify, kind, both");
+  expectError(path("store") + " -o " + path("x.png") + " --foam-threshold 1.5", "--foam-threshold");
+  expectError(path("store") + " -o " + path("x.png") + " --foam-threshold -0.1", "--foam-threshold");
   EXPECT_FALSE(fs::exists(path("x.png")));
 
   // Damaged brick payloads: the error names the frame file; no image is left behind.

@@ -31,8 +31,10 @@ Coverage measureHoles(const flipscope::RenderImage& image) {
   const int w = int(image.width), h = int(image.height);
   std::vector<char> background(std::size_t(w) * h), reached(std::size_t(w) * h, 0);
   Coverage c;
+  // The liquid, or the volumetric foam over it (§3.5: a foam cell is no sphere; the foam that
+  // covers it is in the foam layer).
   for (std::size_t i = 0; i < background.size(); ++i) {
-    background[i] = !std::isfinite(image.depth[i]);
+    background[i] = !std::isfinite(image.depth[i]) && (image.foam.empty() || image.foam[i].a < 0.01f);
     c.foreground += !background[i];
   }
   std::deque<int> queue;
@@ -91,10 +93,15 @@ TEST(SurfaceDefaults, MantaflowFrameRendersClosedWithDefaultSettings) {
   const Coverage defaults = convertAndRender(dir, "defaults", "", "");
   EXPECT_GT(defaults.foreground, 320u * 180u / 20) << "the default camera frames the liquid";
   EXPECT_LT(defaults.holeFraction(), 0.001) << defaults.holes << " hole pixels in " << defaults.foreground;
-
   std::printf("defaults: %zu small-hole pixels in %zu foreground pixels\n", defaults.holes, defaults.foreground);
-  // The old defaults leave the body full of holes: the measure sees them.
-  const Coverage old = convertAndRender(dir, "old", "--resolution 1024", "--radius 1");
+  // Without foam classification every particle is a sphere: the surface alone is closed.
+  const Coverage spheres = convertAndRender(dir, "keep", "", "--foam keep");
+  EXPECT_LT(spheres.holeFraction(), 0.001) << spheres.holes << " hole pixels in " << spheres.foreground;
+  std::printf("--foam keep: %zu small-hole pixels in %zu foreground pixels\n", spheres.holes, spheres.foreground);
+
+  // The old defaults leave the body full of holes: the measure sees them. (Spheres of a quarter
+  // particle spacing touch no neighbour: the classification would take every one for foam.)
+  const Coverage old = convertAndRender(dir, "old", "--resolution 1024", "--radius 1 --foam keep");
   std::printf("old defaults: %zu small-hole pixels in %zu foreground pixels\n", old.holes, old.foreground);
   EXPECT_GT(old.holeFraction(), 0.02) << old.holes << " hole pixels in " << old.foreground;
 }
