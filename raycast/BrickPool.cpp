@@ -9,7 +9,7 @@ namespace flipscope {
 
 std::uint64_t PoolLayout::slotBytes() const {
   return std::uint64_t(subBricksPerSlot) * (16 + (attributes ? 4 : 0) + (foam ? 16 : 0)) +
-         std::uint64_t(mipWordsPerSlot) * 4;
+         std::uint64_t(mipWordsPerSlot + (foam ? foamOccupancyWords() : 0)) * 4;
 }
 
 PoolLayout PoolLayout::forBudget(std::uint32_t brickSize, std::uint32_t overlap, bool attributes,

@@ -26,12 +26,14 @@ struct PoolLayout {
   std::uint32_t mipWordsPerSlot = 0;
   std::uint32_t mipLevels = 0;
   bool attributes = false;
-  bool foam = false;  ///< a foam bit-brick per slot (§3.5), the size of its bits
+  bool foam = false;  ///< a foam bit-brick per slot (§3.5), the size of its bits, and its occupancy
+  /// 32-bit words of a slot's foam occupancy (one bit per sub-brick; FoamClassify.glsl).
+  std::uint32_t foamOccupancyWords() const { return (subBricksPerSlot + 31) / 32; }
   std::uint32_t slots = 0;
   std::uint64_t attributeCapacity = 0;  ///< 16-bit entries in the ring (even)
 
   /// Fixed bytes per slot: bits, mipmap, (with attributes) one 32-bit base per sub-brick and
-  /// (with foam) the foam bits.
+  /// (with foam) the foam bits and their occupancy.
   std::uint64_t slotBytes() const;
   std::uint64_t bytes() const { return slotBytes() * slots + attributeCapacity * 2; }
   /// The largest pool within `budgetBytes`; with attributes, the ring gets room for about 35%

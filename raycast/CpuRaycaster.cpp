@@ -33,6 +33,9 @@ struct RaycastKernel {
   uvec4 rcFoamSubBrick(uint slot, uint subBrick) const {
     return pool->foamBits[std::size_t(slot) * P.brick.w + subBrick];
   }
+  uint rcFoamOccupancy(uint slot, uint word) const {
+    return pool->foamOccupancy[std::size_t(slot) * pool->layout.foamOccupancyWords() + word];
+  }
 
 #include "raycast/glsl/Raycast.glsl"
 };
@@ -77,6 +80,8 @@ void CpuRaycaster::allocatePool(const PoolLayout& layout) {
   mPool.attributes.resize(layout.attributeCapacity);
   mPool.foamBits.clear();
   mPool.foamBits.resize(layout.foam ? std::size_t(layout.slots) * layout.subBricksPerSlot : 0);
+  mPool.foamOccupancy.clear();
+  mPool.foamOccupancy.resize(layout.foam ? std::size_t(layout.slots) * layout.foamOccupancyWords() : 0);
 }
 
 void CpuRaycaster::setOctree(std::span<const OctreeNode> nodes) {
@@ -119,12 +124,15 @@ void CpuRaycaster::classifyFoam(std::span<const std::uint32_t> slots, const Foam
                   params.brick.w == slots.size() * layout.subBricksPerSlot);
   const auto start = std::chrono::steady_clock::now();
   const glsl::FoamKernel kernel{params, &mPool};
-  // In place, as on the GPU: a sub-brick's classification reads no foam bits but its own.
+  // In place, as on the GPU: a sub-brick's classification reads no foam bits but its own; the
+  // occupancy of a brick reads its foam once every sub-brick of it is classified.
   tbb::parallel_for(std::size_t(0), slots.size(), [&](std::size_t i) {
     FLIPSCOPE_CHECK(slots[i] < layout.slots);
     glsl::FoamKernel local = kernel;
     glm::uvec4* foam = &mPool.foamBits[std::size_t(slots[i]) * layout.subBricksPerSlot];
     for (std::uint32_t s = 0; s < layout.subBricksPerSlot; ++s) foam[s] = local.fcClassify(slots[i], s);
+    std::uint32_t* occupancy = &mPool.foamOccupancy[std::size_t(slots[i]) * layout.foamOccupancyWords()];
+    for (std::uint32_t w = 0; w < layout.foamOccupancyWords(); ++w) occupancy[w] = local.fcOccupancyWord(slots[i], w);
   });
   mLastClassifyMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }

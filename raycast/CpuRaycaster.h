@@ -41,6 +41,7 @@ class CpuRaycaster : public RaycastDevice {
     UninitializedVector<std::uint32_t> attributeBases;
     UninitializedVector<std::uint16_t> attributes;
     UninitializedVector<glm::uvec4> foamBits;  ///< with a foam pool: per slot, as subBricks
+    UninitializedVector<std::uint32_t> foamOccupancy;  ///< per slot, PoolLayout::foamOccupancyWords
   };
   const Pool& pool() const { return mPool; }
 

@@ -261,7 +261,7 @@ RenderStats FrameRenderer::trace(int frame, const Camera& camera, int direction)
     mDevice->setPageTable(pages);
     stats.uploadMs += msSince(uploadStart);
     // §3.5: the bricks uploaded in this pass are classified in one batch before the next trace.
-    if (mSettings.foam.classifies() && !uploadedSlots.empty()) {
+    if (mSettings.foam.mode != FoamMode::Keep && !uploadedSlots.empty()) {
       mDevice->classifyFoam(uploadedSlots, foamParams(uploadedSlots.size()));
       stats.foamMs += mDevice->lastClassifyMs();
       stats.bricksClassified += uploadedSlots.size();

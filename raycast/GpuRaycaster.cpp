@@ -26,6 +26,7 @@ enum Binding : GLuint {
   kRequestFlags = 9,
   kFoam = 10,
   kBatch = 11,  // FoamClassify.comp: the batch's slots
+  kFoamOccupancy = 12,
 };
 constexpr std::uint32_t kGroupSize = 8;      // local_size_x and _y of Raycast.comp
 constexpr std::uint32_t kFoamGroupSize = 64;  // local_size_x of FoamClassify.comp
@@ -51,7 +52,8 @@ GpuRaycaster::GpuRaycaster()
   const std::string renderer = mContext.renderer();
   mSoftware = renderer.find("llvmpipe") != std::string::npos || renderer.find("softpipe") != std::string::npos;
   mParams = makeBuffer(sizeof(RaycastParams));
-  mFoam = makeBuffer(0);  // bound by every trace; a pool without foam never reads it
+  mFoam = makeBuffer(0);  // bound by every trace; a pool without foam never reads them
+  mFoamOccupancy = makeBuffer(0);
 }
 
 GpuRaycaster::~GpuRaycaster() = default;
@@ -65,6 +67,7 @@ void GpuRaycaster::allocatePool(const PoolLayout& layout) {
   mAttributeBases = makeBuffer(layout.attributes ? std::uint64_t(layout.slots) * layout.subBricksPerSlot * 4 : 0);
   mAttributes = makeBuffer(layout.attributeCapacity * 2);
   mFoam = makeBuffer(layout.foam ? std::uint64_t(layout.slots) * layout.subBricksPerSlot * 16 : 0);
+  mFoamOccupancy = makeBuffer(layout.foam ? std::uint64_t(layout.slots) * layout.foamOccupancyWords() * 4 : 0);
 }
 
 void GpuRaycaster::setOctree(std::span<const OctreeNode> nodes) {
@@ -110,7 +113,10 @@ void GpuRaycaster::classifyFoam(std::span<const std::uint32_t> slots, const Foam
                   params.brick.w == slots.size() * mLayout.subBricksPerSlot);
   mLastClassifyMs = 0;
   if (slots.empty()) return;
-  if (!mFoamProgram.id()) mFoamProgram = gl::Program::compute(gl::shaderSource("FoamClassify.comp"));
+  if (!mFoamProgram.id()) {
+    mFoamProgram = gl::Program::compute(gl::shaderSource("FoamClassify.comp"));
+    mOccupancyProgram = gl::Program::compute(gl::shaderSource("FoamOccupancy.comp"));
+  }
   if (!mFoamParams.id()) mFoamParams = makeBuffer(sizeof(FoamClassifyParams));
   mFoamParams.upload(0, &params, sizeof(params));
   if (mBatch.size() < slots.size_bytes()) mBatch = makeBuffer(std::max<std::uint64_t>(slots.size_bytes(), 4096));
@@ -120,10 +126,17 @@ void GpuRaycaster::classifyFoam(std::span<const std::uint32_t> slots, const Foam
   mSubBricks.bindBase(GL_SHADER_STORAGE_BUFFER, kSubBricks);
   mFoam.bindBase(GL_SHADER_STORAGE_BUFFER, kFoam);
   mBatch.bindBase(GL_SHADER_STORAGE_BUFFER, kBatch);
-  mFoamProgram.use();
+  mFoamOccupancy.bindBase(GL_SHADER_STORAGE_BUFFER, kFoamOccupancy);
   const auto start = std::chrono::steady_clock::now();
   mTimer.begin();
-  mFoamProgram.dispatch((params.brick.w + kFoamGroupSize - 1) / kFoamGroupSize, 1, 1);
+  if (params.sphere.z > 0.5f) {
+    mFoamProgram.use();
+    mFoamProgram.dispatch((params.brick.w + kFoamGroupSize - 1) / kFoamGroupSize, 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  }
+  mOccupancyProgram.use();
+  const std::uint64_t words = std::uint64_t(slots.size()) * mLayout.foamOccupancyWords();
+  mOccupancyProgram.dispatch(std::uint32_t((words + kFoamGroupSize - 1) / kFoamGroupSize), 1, 1);
   mTimer.end();
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
   if (mSoftware) glFinish();
@@ -164,6 +177,7 @@ std::vector<std::uint32_t> GpuRaycaster::trace(const RaycastParams& params) {
   mRequests.bindBase(GL_SHADER_STORAGE_BUFFER, kRequests);
   mRequestFlags.bindBase(GL_SHADER_STORAGE_BUFFER, kRequestFlags);
   mFoam.bindBase(GL_SHADER_STORAGE_BUFFER, kFoam);
+  mFoamOccupancy.bindBase(GL_SHADER_STORAGE_BUFFER, kFoamOccupancy);
   mProgram.use();
   const auto start = std::chrono::steady_clock::now();
   mTimer.begin();

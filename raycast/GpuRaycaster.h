@@ -40,14 +40,15 @@ class GpuRaycaster : public RaycastDevice {
  private:
   gl::EglContext mContext;
   gl::Program mProgram;
-  gl::Program mFoamProgram;  ///< raycast/glsl/FoamClassify.comp, compiled on first use
+  gl::Program mFoamProgram;       ///< raycast/glsl/FoamClassify.comp, compiled on first use
+  gl::Program mOccupancyProgram;  ///< raycast/glsl/FoamOccupancy.comp, likewise
   gl::TimerQuery mTimer;
   std::uint64_t mMaxBufferBytes = 0;
   PoolLayout mLayout;
   std::uint32_t mWidth = 0, mHeight = 0;
   std::size_t mBricks = 0;  ///< bricks of the current frame (page table entries)
   gl::Buffer mParams, mNodes, mPages, mSubBricks, mMips, mAttributeBases, mAttributes, mHits, mRequests, mRequestFlags;
-  gl::Buffer mFoam, mFoamParams, mBatch;
+  gl::Buffer mFoam, mFoamOccupancy, mFoamParams, mBatch;
   double mLastTraceMs = 0;
   double mLastClassifyMs = 0;
   bool mSoftware = false;  ///< Mesa llvmpipe/softpipe: timer queries return ~0, passes are timed on the wall clock

@@ -19,6 +19,7 @@
 #include "preprocess/SynthFluid.h"
 #include "raycast/GpuRaycaster.h"
 #include "pipeline/FramePipeline.h"
+#include "tools/BenchFoam.h"
 #include "tools/JsonOutput.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
@@ -150,6 +151,15 @@ void runBenchRender(const BenchRenderArgs& a) {
     lastCamera = camera;
   }
 
+  // Foam and absorption at the last size, each added on its own (the same camera).
+  RenderSettings foamSettings;
+  foamSettings.width = sizes.back().first;
+  foamSettings.height = sizes.back().second;
+  foamSettings.gpuBudgetBytes = parseBytes("--gpu-mem", a.gpuMem);
+  foamSettings.radius = defaultSphereRadius(BrickStore::open(storeDir).header(), foamSettings.jitter);
+  if (!a.json) std::fprintf(stderr, "bench render: foam and absorption at %ux%u ...\n", foamSettings.width, foamSettings.height);
+  const FoamTraceTiming foam = timeFoamAndAbsorption(storeDir, choice, foamSettings, lastCamera, a.orbitFrames);
+
   std::optional<double> vdbTool;
   const auto [vw, vh] = sizes.back();
   if (!a.skipVdbTool) {
@@ -165,7 +175,14 @@ void runBenchRender(const BenchRenderArgs& a) {
                      {"height", main.height},
                      {"first_image_s", main.firstImageSeconds},
                      {"frame_ms", main.frameMs},
-                     {"vdb_tool_s", vdbTool ? nlohmann::json(*vdbTool) : nlohmann::json(nullptr)}};
+                     {"vdb_tool_s", vdbTool ? nlohmann::json(*vdbTool) : nlohmann::json(nullptr)},
+                     {"foam", {{"trace_spheres_ms", foam.spheresMs},
+                               {"trace_absorption_ms", foam.absorptionMs},
+                               {"trace_remove_ms", foam.removeMs},
+                               {"trace_volume_ms", foam.volumeMs},
+                               {"absorption_ms", foam.absorptionCost()},
+                               {"volumetric_foam_ms", foam.volumeCost()},
+                               {"classification_ms", foam.classifyMs}}}};
     for (const SizeResult& r : results)
       j["sizes"].push_back({{"width", r.width},
                             {"height", r.height},
@@ -185,6 +202,17 @@ void runBenchRender(const BenchRenderArgs& a) {
     std::printf("%5ux%-5u %14.3f %8d %10llu %12.0f %14.1f %14.1f\n", r.width, r.height, r.firstImageSeconds,
                 r.cold.passes, (unsigned long long)r.cold.bricksUploaded, r.cold.streamMs, r.frameMs, r.traceMs);
   std::printf("%-11s %14s %8s %10s %12s %14s %14s\n", "paper", "-", "-", "-", "-", "8.5-50 (GPU)", "");
+  std::printf("\nfoam and absorption at %ux%u, warm trace ms (median of %d frames, the variants in turn), %s:\n", main.width, main.height,
+              a.orbitFrames, foam.device.c_str());
+  std::printf("  %-44s %10s %10s %18s\n", "", "trace ms", "added ms", "paper (GTX Titan)");
+  std::printf("  %-44s %10.1f %10s %18s\n", "spheres (--foam keep, no thickness)", foam.spheresMs, "-", "20-27 (Sphere)");
+  std::printf("  %-44s %10.1f %+10.1f %18s\n", "+ absorption (density trace, §3.6)", foam.absorptionMs,
+              foam.absorptionCost(), "12-14 (Trans)");
+  std::printf("  %-44s %10.1f %+10.1f %18s\n", "+ foam cells skipped (--foam remove)", foam.removeMs,
+              foam.removeMs - foam.absorptionMs, "-");
+  std::printf("  %-44s %10.1f %+10.1f %18s\n", "+ volumetric foam (--foam volume, default)", foam.volumeMs,
+              foam.volumeCost(), "12-34 (Foam)");
+  std::printf("  foam classification of the cold frame's bricks: %.1f ms\n", foam.classifyMs);
   if (vdbTool)
     std::printf("\nfirst image at %ux%u: vdb_tool -points2ls -render %.2f s, flipscope %.2f s (%.1fx faster)\n", vw, vh,
                 *vdbTool, main.firstImageSeconds, *vdbTool / main.firstImageSeconds);

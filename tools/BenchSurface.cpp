@@ -57,6 +57,7 @@
 #include "smoothing/GpuScreenDevice.h"
 #include "smoothing/SurfaceNormals.h"
 #include "smoothing/SurfaceShading.h"
+#include "tools/BenchFoam.h"
 #include "tools/JsonOutput.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
@@ -75,6 +76,7 @@ constexpr int kSilhouettePixels = 3;  // measured pixels lie this far from an an
 // Reichl et al. 2014 Fig. 10: smoothing at 1280x720 on a GTX Titan.
 constexpr double kPaperBilateralMs = 15.0;
 constexpr double kPaperRofMs = 13.0;
+constexpr double kPaperFoamMsPerBrick = 0.15;  // Table 2, 64^3 bricks
 constexpr int kPaperRofIterations = 75;
 
 struct BenchSurfaceArgs {
@@ -427,6 +429,11 @@ void runBenchSurface(const BenchSurfaceArgs& a) {
     context = gl::EglContext();
   }
 
+  // Foam classification (§3.5) of every brick the view uploads, on each device.
+  std::vector<FoamClassifyTiming> foam;
+  if (useCpu) foam.push_back(timeFoamClassification(storeDir, DeviceChoice::Cpu, settings, camera, a.repeats));
+  if (!glName.empty()) foam.push_back(timeFoamClassification(storeDir, DeviceChoice::Gpu, settings, camera, a.repeats));
+
   // The fastest device's ROF.
   double rofMs = 0;
   std::string rofDevice;
@@ -483,7 +490,11 @@ void runBenchSurface(const BenchSurfaceArgs& a) {
                   {"height", 720},
                   {"bilateral_ms", kPaperBilateralMs},
                   {"rof_ms", kPaperRofMs},
-                  {"rof_iterations", kPaperRofIterations}};
+                  {"rof_iterations", kPaperRofIterations},
+                  {"foam_classification_ms_per_brick", kPaperFoamMsPerBrick}};
+    j["foam_classification"] = Json::array();
+    for (const FoamClassifyTiming& f : foam)
+      j["foam_classification"].push_back({{"device", f.device}, {"bricks", f.bricks}, {"ms_per_brick", f.msPerBrick}});
     printJson(j);
     return;
   }
@@ -530,6 +541,12 @@ void runBenchSurface(const BenchSurfaceArgs& a) {
   std::printf(
       "normal error: angle to the analytic normal; depth error: |smoothed depth - analytic depth of the "
       "surface offset by the particle radius| in cells (bias: signed mean, + = behind)\n");
+  std::printf("\nfoam classification (§3.5), radius %.2f cells, every brick of the view (%u^3 cells), median of %d:\n",
+              settings.radius, header.brickSize, a.repeats);
+  for (const FoamClassifyTiming& f : foam)
+    std::printf("  %-60s %6llu bricks %9.3f ms per brick\n", f.device.c_str(), (unsigned long long)f.bricks,
+                f.msPerBrick);
+  std::printf("  %-60s %13s %9.2f ms per 64^3 brick\n", "paper (Table 2, GTX Titan)", "", kPaperFoamMsPerBrick);
   std::printf("store and images (surface_<filter>.png) in %s\n", work.c_str());
 }
 

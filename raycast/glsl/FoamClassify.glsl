@@ -7,6 +7,9 @@
 //   uvec4 fcFoam(uint slot, uint subBrick)       its foam bit-brick as uploaded: the cells whose
 //                                                stored kind counts as foam (zeros without)
 //
+// Two passes, the second after the first has finished: fcClassify writes the foam bits, then
+// fcOccupancyWord summarises them per sub-brick for the volume's empty-space skipping.
+//
 // One invocation per sub-brick of a batch of freshly uploaded bricks: it reads the bits around
 // its sub-brick and returns its foam bits, which the includer writes over fcFoam of the same
 // sub-brick. An invocation writes only its own sub-brick and reads no foam bits but its own, so
@@ -61,4 +64,27 @@ FS_FUNC uvec4 fcClassify(uint slot, uint subBrick) {
     if (float(count) < needed) foam[int(bit >> 5u)] |= 1u << (bit & 31u);
   }
   return foam;
+}
+
+// The foam occupancy of sub-bricks 32 word .. 32 word + 31 of `slot`, one bit each: set when the
+// sub-brick or one of its 26 neighbours holds a foam cell, so the volume's trilinear density
+// (Raycast.glsl, rcFoamDensity) is 0 everywhere in a sub-brick whose bit is clear. One
+// invocation per word, after fcClassify has written every sub-brick of the slot.
+FS_FUNC uint fcOccupancyWord(uint slot, uint word) {
+  uvec3 dims = bitBrickSubBrickDims(FP.brick.x, FP.brick.y);
+  uint occupancy = 0u;
+  for (uint i = 0u; i < 32u; i++) {
+    uint subBrick = word * 32u + i;
+    if (subBrick >= FP.brick.z) break;
+    ivec3 c = ivec3(int(subBrick % dims.x), int((subBrick / dims.x) % dims.y), int(subBrick / (dims.x * dims.y)));
+    bool foam = false;
+    for (int d = 0; d < 27 && !foam; d++) {
+      ivec3 q = c + ivec3(d % 3 - 1, (d / 3) % 3 - 1, d / 9 - 1);
+      if (q.x < 0 || q.y < 0 || q.z < 0 || q.x >= int(dims.x) || q.y >= int(dims.y) || q.z >= int(dims.z)) continue;
+      uvec4 f = fcFoam(slot, uint(q.x) + dims.x * (uint(q.y) + dims.y * uint(q.z)));
+      foam = (f.x | f.y | f.z | f.w) != 0u;
+    }
+    if (foam) occupancy |= 1u << i;
+  }
+  return occupancy;
 }

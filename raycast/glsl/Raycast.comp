@@ -19,6 +19,7 @@ layout(std430, binding = 7) buffer HitBuffer { RayHit hits[]; };
 layout(std430, binding = 8) buffer RequestBuffer { uint requestCount; uint requests[]; };
 layout(std430, binding = 9) buffer RequestFlagBuffer { uint requestFlags[]; };  // one per brick, cleared per pass
 layout(std430, binding = 10) readonly buffer FoamBuffer { uvec4 foamBits[]; };  // as subBricks, with kFoamSkip
+layout(std430, binding = 12) readonly buffer FoamOccupancyBuffer { uint foamOccupancy[]; };  // with kFoamVolume
 
 uvec2 rcNode(uint node) { return nodes[node]; }
 uint rcPage(uint brickIndex) { return pages[brickIndex]; }
@@ -26,6 +27,7 @@ uvec4 rcSubBrick(uint slot, uint subBrick) { return subBricks[slot * P.brick.w +
 uint rcMipWord(uint slot, uint word) { return mipWords[slot * P.pool.x + word]; }
 uint rcAttributeBase(uint slot, uint subBrick) { return attributeBases[slot * P.brick.w + subBrick]; }
 uvec4 rcFoamSubBrick(uint slot, uint subBrick) { return foamBits[slot * P.brick.w + subBrick]; }
+uint rcFoamOccupancy(uint slot, uint word) { return foamOccupancy[slot * ((P.brick.w + 31u) / 32u) + word]; }
 uint rcAttribute(uint index) { return (attributePairs[index >> 1u] >> ((index & 1u) * 16u)) & 0xffffu; }
 
 // The request buffer (§3.3): a brick is appended once per pass; overflow is dropped (the ray

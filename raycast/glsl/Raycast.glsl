@@ -9,6 +9,8 @@
 //   uint  rcMipWord(uint slot, uint word)         its occupancy mipmap (BrickMipmap.h layout)
 //   uvec4 rcFoamSubBrick(uint slot, uint subBrick)  its foam bit-brick (FoamClassify.glsl), read
 //                                                 only with kFoamSkip
+//   uint  rcFoamOccupancy(uint slot, uint word)   its foam occupancy (fcOccupancyWord), with
+//                                                 kFoamVolume
 //   uint  rcAttributeBase(uint slot, uint subBrick)  attribute index of the sub-brick's first set cell
 //   uint  rcAttribute(uint index)                 16-bit attribute value
 //   void  rcRequest(uint brickIndex)              asks for a brick (deduplicated by the includer)
@@ -115,12 +117,18 @@ FS_FUNC float rcFoamDensity(uint slot, vec3 p) {
 FS_FUNC float rcAccumulateFoam(float opacity, uint slot, vec3 o, vec3 dir, float a, float b) {
   float step = P.volume.x;
   float i = -floor(0.5f - a / step);  // the first i with t_i >= a
+  uvec3 dims = bitBrickSubBrickDims(P.grid.w, P.brick.x);
   for (uint n = 0u; n < kRaycastMaxSteps && opacity < P.volume.z; n++) {
     float t = (i + 0.5f) * step;
     if (t >= b) break;
-    float density = rcFoamDensity(slot, o + t * dir);
-    if (density > 0.0f) opacity += (1.0f - opacity) * (1.0f - exp(-P.volume.y * density * step));
     i += 1.0f;
+    // Empty-space skipping: no foam within a sub-brick of the sample, no density.
+    vec3 p = o + t * dir;
+    uvec3 s = uvec3(clamp(ivec3(floor(p)) + ivec3(int(P.brick.x)), ivec3(0), ivec3(int(P.grid.w + 2u * P.brick.x) - 1)));
+    uint subBrick = (s.x >> 2u) + dims.x * ((s.y >> 2u) + dims.y * (s.z >> 3u));
+    if (((rcFoamOccupancy(slot, subBrick >> 5u) >> (subBrick & 31u)) & 1u) == 0u) continue;
+    float density = rcFoamDensity(slot, p);
+    if (density > 0.0f) opacity += (1.0f - opacity) * (1.0f - exp(-P.volume.y * density * step));
   }
   return opacity;
 }
@@ -260,8 +268,8 @@ struct ThicknessTrace {
 
 // Thickness of the liquid behind a hit at tHit (§3.6: "tracing each ray through the fluid body,
 // using our proposed density calculation, until maximum absorption is reached"): the density of
-// the sphere cells (rcLiquidDensity) summed at unit steps along the ray until it reaches
-// P.sphere.w cells, after at most kThicknessMaxCells steps, or at the grid's end. With
+// the sphere cells (rcLiquidDensity) summed at steps of kThicknessStep cells along the ray until
+// it reaches P.sphere.w cells, after kThicknessMaxCells cells, or at the grid's end. With
 // P.sphere.z = 1 (best effort) bricks that are not resident count as empty.
 FS_FUNC ThicknessTrace rcThickness(vec3 eye, vec3 dir, float tHit) {
   int B = int(P.grid.w);
@@ -272,8 +280,8 @@ FS_FUNC ThicknessTrace rcThickness(vec3 eye, vec3 dir, float tHit) {
   ThicknessTrace trace;
   trace.cells = 0.0f;
   trace.missingBrick = kNotResident;
-  for (uint i = 0u; i < kThicknessMaxCells && trace.cells < P.sphere.w; i++) {
-    vec3 p = eye + (tHit + 0.5f + float(i)) * dir;
+  for (uint i = 0u; i < kThicknessMaxCells / kThicknessStep && trace.cells < P.sphere.w; i++) {
+    vec3 p = eye + (tHit + (0.5f + float(i)) * float(kThicknessStep)) * dir;
     ivec3 cell = ivec3(floor(p));
     if (cell.x < 0 || cell.y < 0 || cell.z < 0 || cell.x >= gridCells.x || cell.y >= gridCells.y ||
         cell.z >= gridCells.z)
@@ -288,7 +296,7 @@ FS_FUNC ThicknessTrace rcThickness(vec3 eye, vec3 dir, float tHit) {
         return trace;
       }
     }
-    if (slot != kNotResident) trace.cells += rcLiquidDensity(slot, p - vec3(brick * B));
+    if (slot != kNotResident) trace.cells += rcLiquidDensity(slot, p - vec3(brick * B)) * float(kThicknessStep);
   }
   return trace;
 }

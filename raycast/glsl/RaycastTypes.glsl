@@ -41,9 +41,9 @@ struct RayHit {
   uint brickIndex; // brick of the hit, or the brick a pending ray waits for (0 before the first
                    // pass), kNotResident on a miss
   float thickness; // liquid along the ray behind the hit, world units (§3.6): the density of the
-                   // surface cells (set bits of the 4^3 half sub-brick at each unit step), summed
-                   // until it reaches sphere.w cells or after kThicknessMaxCells steps, times the
-                   // cell size; -1 while the bricks it needs are not resident
+                   // surface cells (set bits of the 4^3 half sub-brick at every kThicknessStep
+                   // cells), summed until it reaches sphere.w cells or after kThicknessMaxCells
+                   // cells, times the cell size; -1 while the bricks it needs are not resident
   float foam;      // opacity of the volumetric foam in front of the hit (or along a miss), 0..1
                    // (§3.5); it accumulates while the ray is pending; 0 without kFoamVolume
   float unused1;
@@ -53,6 +53,7 @@ struct RayHit {
 const uint kNotResident = 0xffffffffu;
 const uint kMaxMipLevels = 8u;  // 144 stored cells (128 + 2 x 8) make 7
 const uint kRaycastMaxSteps = 65536u;  // bound on each traversal loop of one ray in one pass
-const uint kThicknessMaxCells = 128u;  // unit steps behind a hit at most, for its thickness
+const uint kThicknessMaxCells = 128u;  // cells behind a hit at most, for its thickness
+const uint kThicknessStep = 2u;        // cells between its samples (the density is of 4^3 blocks)
 const uint kFoamSkip = 1u;    // the pool's foam bit-bricks are valid: foam cells are no spheres
 const uint kFoamVolume = 2u;  // foam is accumulated along the ray as a volume (with kFoamSkip)
