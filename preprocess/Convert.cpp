@@ -759,9 +759,8 @@ FrameReport convertOneFrame(ParticleSource& source, BrickStore& store, int frame
   FrameBinner binner(grid, kind, plan, options, scratch, frame);
   ParticleChunk chunk;
   while (source.read(chunk, plan.chunkParticles)) {
-    if (header.particleKinds &&
-        (chunk.attributes.size() < (attribute && kind != AttributeKind::Speed ? 2u : 1u) ||
-         chunk.attributes.back().arity != 1))
+    const std::size_t storedColumns = kind == AttributeKind::Scalar || kind == AttributeKind::Magnitude ? 1 : 0;
+    if (header.particleKinds && (chunk.attributes.size() != storedColumns + 1 || chunk.attributes.back().arity != 1))
       throw FileError(source.name(), "was read without the column of particle types that the store keeps");
     if (kind == AttributeKind::Scalar || kind == AttributeKind::Magnitude) {
       // The source must have been opened with ReadOptions::attributes = {the store's attribute}.
@@ -839,7 +838,7 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
   std::vector<std::vector<AttributeDesc>> held;  // with a name asked for: what each input holds
   KindAttributes kindAttributes;
   bool kinds = false;
-  std::vector<AttributeDesc> firstHeld;  // what the first file holds, for a kind attribute none has
+  std::vector<AttributeDesc> firstHeld;  // what the first file holds: for a kind attribute no file has
   for (const auto& input : inputs) {
     std::vector<std::unique_ptr<ParticleSource>> parts;
     kindAttributes.emplace_back();
@@ -847,7 +846,7 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
       parts.push_back(openParticleFile(file, probe));
       kindAttributes.back().push_back(kindAttributeOf(options.kindAttribute, *parts.back()));
       kinds = kinds || !kindAttributes.back().back().empty();
-      if (firstHeld.empty()) firstHeld = parts.back()->attributes();
+      if (&input == &inputs.front() && &file == &input.files.front()) firstHeld = parts.back()->attributes();
     }
     auto source = joined(std::move(parts));
     allVelocity = allVelocity && source->hasVelocity();

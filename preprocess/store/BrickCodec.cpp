@@ -7,8 +7,9 @@
 // Separate streams compress far better than interleaved ones: at 8 particles per cell most
 // gaps and counts are tiny and repeat. Particles are quantized to their cell (Reichl et al.
 // 2014 §3, §4.3), so cells and counts are all that is left of the positions. A byte per kind
-// rather than 2 bits: nearly every cell is liquid, and zstd turns the long runs of zeros into a
-// few bytes either way (measured on the Mantaflow sample, README "The brick store").
+// rather than 2 bits a cell: plain to check (a value >= 4 is refused) and about as small after
+// zstd. On the 30 frames of the Mantaflow sample (320,612 cells, a quarter not liquid) the kinds
+// add 1.23 bits a cell (49.3 KB to 204.2 KB at level 1); 2 bits packed four to a byte, 1.04.
 #include <zstd.h>
 
 #include <algorithm>

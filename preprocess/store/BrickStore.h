@@ -102,6 +102,7 @@ struct StoreHeader {
   /// Made by BrickStore::createOrAppend for a new store (random unless given); frames carry it.
   StoreId id{};
   /// Every brick carries a ParticleKind per occupied cell (DecodedBrick::kinds). Version 5 only.
+  /// convert quantizes the attribute of such stores to 14 bits (BrickBinning.h).
   bool particleKinds = false;
 
   glm::dvec3 domainMax() const { return origin + glm::dvec3(brickGrid) * double(brickSize) * cellSize; }
