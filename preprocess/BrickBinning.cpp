@@ -50,8 +50,15 @@ float attributeValue(const ParticleChunk& chunk, AttributeKind kind, std::size_t
   return 0.0f;
 }
 
-KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, AttributeKind kind, KeyBatch& out) {
+ParticleKind kindOfTypeValue(float flags) {
+  if (!(flags >= -2147483648.0f && flags < 2147483648.0f)) return ParticleKind::Liquid;  // NaN too
+  return fromMantaflowType(std::int32_t(flags));
+}
+
+KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, AttributeKind kind, KeyBatch& out,
+                     const AttributeColumn* types) {
   const std::size_t n = chunk.size();
+  FLIPSCOPE_CHECK(!types || (types->arity == 1 && types->values.size() == n), "a type column needs one value a particle");
   const bool attribute = kind != AttributeKind::None;
   FLIPSCOPE_CHECK(kind != AttributeKind::Speed || chunk.velocities.size() == n, "speed needs velocities");
   FLIPSCOPE_CHECK(kind != AttributeKind::Scalar || (!chunk.attributes.empty() && chunk.attributes.front().arity == 1 &&
@@ -97,6 +104,7 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, AttributeK
           const std::uint64_t code = mortonEncode3(brick.x, brick.y, brick.z);
           const std::uint64_t inBrick = local.x | (local.y << grid.brickShift) | (local.z << (2 * grid.brickShift));
           keys[i] = (code << grid.cellBits) | inBrick;
+          if (types) keys[i] |= std::uint64_t(kindOfTypeValue(types->values[i])) << kKindShift;
           if (values) {
             const float s = attributeValue(chunk, kind, i);
             values[i] = s;
@@ -211,15 +219,23 @@ void splitByBrick(std::uint64_t* keys, std::uint64_t* scratch, std::size_t begin
       splitByBrick(keys, scratch, begin + starts[d], begin + starts[d + 1], lowBit, shift, !inScratch, runs);
 }
 
-/// Encodes one brick's keys (same brick code, any order) into `out` (reuses its vectors).
-void decodeRun(std::span<std::uint64_t> keys, const KeyGrid& grid, bool attribute, DecodedBrick& out,
-               std::vector<std::uint32_t>& histogram) {
+/// Encodes one brick's keys (same brick code, any order) into `out` (reuses its vectors); with
+/// `kinds`, a cell's kind is the smallest of its keys' (the key layout of binningKey).
+void decodeRun(std::span<std::uint64_t> keys, const KeyGrid& grid, bool attribute, bool kinds, DecodedBrick& out,
+               std::vector<std::uint32_t>& histogram, std::vector<ParticleKind>& cellKinds) {
   out.cells.clear();
   out.counts.clear();
   out.attributes.clear();
+  out.kinds.clear();
   const std::uint32_t cellsPerBrick = grid.header.cellsPerBrick();
   const std::uint64_t cellMask = (1ull << grid.cellBits) - 1;
   auto cellOf = [&](std::uint64_t key) { return std::uint32_t((key >> 16) & cellMask); };
+  auto kindOf = [](std::uint64_t key) { return ParticleKind(key & 3); };
+  auto attributeOf = [kinds](std::uint64_t key) {
+    if (!kinds) return std::uint16_t(key & 0xffff);
+    const auto narrow = std::uint32_t((key >> 2) & 0x3fff);
+    return std::uint16_t((narrow << 2) | (narrow >> 12));  // 14 bits widened: 0 -> 0, 16383 -> 65535
+  };
   if (keys.size() * 16 < cellsPerBrick) {
     // Sparse: sort (cell, attribute) directly.
     std::sort(keys.begin(), keys.end());
@@ -228,27 +244,34 @@ void decodeRun(std::span<std::uint64_t> keys, const KeyGrid& grid, bool attribut
       if (out.cells.empty() || out.cells.back() != cell) {
         out.cells.push_back(cell);
         out.counts.push_back(0);
+        if (kinds) out.kinds.push_back(kindOf(keys[i]));
       }
       ++out.counts.back();
-      if (attribute) out.attributes.push_back(std::uint16_t(keys[i] & 0xffff));
+      if (kinds) out.kinds.back() = std::min(out.kinds.back(), kindOf(keys[i]));
+      if (attribute) out.attributes.push_back(attributeOf(keys[i]));
     }
     return;
   }
   // Dense: histogram over the brick's cells.
   histogram.assign(cellsPerBrick, 0);
   for (auto k : keys) ++histogram[cellOf(k)];
+  if (kinds) {
+    cellKinds.assign(cellsPerBrick, ParticleKind(kParticleKindCount - 1));
+    for (auto k : keys) cellKinds[cellOf(k)] = std::min(cellKinds[cellOf(k)], kindOf(k));
+  }
   std::uint32_t offset = 0;
   for (std::uint32_t c = 0; c < cellsPerBrick; ++c) {
     if (!histogram[c]) continue;
     out.cells.push_back(c);
     out.counts.push_back(histogram[c]);
+    if (kinds) out.kinds.push_back(cellKinds[c]);
     const std::uint32_t count = histogram[c];
     histogram[c] = offset;  // becomes the cell's first attribute slot
     offset += count;
   }
   if (!attribute) return;
   out.attributes.resize(keys.size());
-  for (auto k : keys) out.attributes[histogram[cellOf(k)]++] = std::uint16_t(k & 0xffff);
+  for (auto k : keys) out.attributes[histogram[cellOf(k)]++] = attributeOf(k);
   std::size_t start = 0;
   for (auto count : out.counts) {
     std::sort(out.attributes.begin() + start, out.attributes.begin() + start + count);
@@ -258,7 +281,7 @@ void decodeRun(std::span<std::uint64_t> keys, const KeyGrid& grid, bool attribut
 
 }  // namespace
 
-void binKeys(KeyVector& keys, KeyVector& scratch, const KeyGrid& grid, bool attribute,
+void binKeys(KeyVector& keys, KeyVector& scratch, const KeyGrid& grid, bool attribute, bool kinds,
              int zstdLevel, const std::function<void(EncodedBrick&&)>& sink) {
   if (keys.empty()) return;
   scratch.resize(keys.size());
@@ -276,8 +299,10 @@ void binKeys(KeyVector& keys, KeyVector& scratch, const KeyGrid& grid, bool attr
       std::span<std::uint64_t> span((run.inScratch ? scratch : keys).data() + run.begin, run.end - run.begin);
       thread_local DecodedBrick brick;
       thread_local std::vector<std::uint32_t> histogram;
-      decodeRun(span, grid, attribute, brick, histogram);
+      thread_local std::vector<ParticleKind> cellKinds;
+      decodeRun(span, grid, attribute, kinds, brick, histogram, cellKinds);
       EncodedBrick& e = batch[i];
+      for (ParticleKind kind : brick.kinds) ++e.kindCells[std::size_t(kind)];
       e.coord = glm::uvec3(mortonDecode3(std::uint32_t(span[0] >> lowBit)));
       e.particles = std::uint32_t(span.size());
       e.cells = std::uint32_t(brick.cells.size());

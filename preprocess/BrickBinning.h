@@ -7,8 +7,17 @@
 // the canonical order of a brick payload. Keys are built without the attribute first
 // (`cellKey`, 48 bits) because the attribute's quantization range is known only after the
 // whole frame was read.
+//
+// Stores with particle kinds: the cell key carries the particle's kind in bits 48-49 (through
+// the counting sort by brick and the spill files, which look at the brick code only), and the
+// full key is [ brick ][ cell ][ attribute : 14 bits ][ kind : 2 bits ] (binningKey). Of the
+// layouts that fit 64 bits this is the simplest and fastest: nothing travels beside the keys,
+// attributes stay ascending within a cell (DecodedBrick), and a cell's kind, the smallest of its
+// particles', is taken on the pass that groups the cell's keys anyway. The price: attributes of
+// such stores are quantized to 14 bits (widened back to 16 when stored, 0 and max kept).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -18,6 +27,7 @@
 #include "core/Box.h"
 #include "core/UninitializedVector.h"
 #include "preprocess/store/BrickStore.h"
+#include "preprocess/store/ParticleKind.h"
 #include "preprocess/particles/ParticleSource.h"
 
 namespace flipscope::detail {
@@ -34,8 +44,11 @@ struct KeyGrid {
   std::uint32_t cellBits;   ///< 3 * brickShift
   std::uint32_t codeBits;   ///< 3 * octree levels: bits of a brick Morton code
 
-  std::uint64_t brickCodeOf(std::uint64_t cellKey) const { return cellKey >> cellBits; }
 };
+
+/// Bits of a cell key below the kind (ParticleKind in bits 48-49 of stores with kinds).
+inline constexpr std::uint32_t kKindShift = 48;
+inline constexpr std::uint64_t kCellKeyMask = (1ull << kKindShift) - 1;
 
 using KeyVector = UninitializedVector<std::uint64_t>;
 using ValueVector = UninitializedVector<float>;
@@ -64,25 +77,41 @@ struct KeyTally {
 /// for Scalar, the length of its components for Magnitude.
 float attributeValue(const ParticleChunk& chunk, AttributeKind kind, std::size_t i);
 
+/// The kind of a particle whose type column (converted to float) holds `flags`: Mantaflow's
+/// type flags (fromMantaflowType); a value that is no int32 is liquid.
+ParticleKind kindOfTypeValue(float flags);
+
 /// Appends the keys of `chunk` to `out` (parallel over the chunk, deterministic order), and the
-/// values of attribute `kind` (attributeValue; not None) when it is not None.
-KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, AttributeKind kind, KeyBatch& out);
+/// values of attribute `kind` (attributeValue; not None) when it is not None. With `types` (a
+/// column of chunk, arity 1: the particles' type flags), each key carries the particle's kind
+/// (kindOfTypeValue) in bits 48-49; without, none (liquid).
+KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, AttributeKind kind, KeyBatch& out,
+                     const AttributeColumn* types = nullptr);
 
 /// Quantizes value s into [0, 65535] over [min, max] (NaN and -inf: 0, +inf: 65535).
 std::uint16_t quantizeAttribute(float s, float min, float max);
+
+/// The full 64-bit key of a cell key (kind included) and its quantized attribute: without kinds
+/// [cell key][attribute]; with `kinds` [cell key][attribute / 4, 14 bits][kind].
+inline std::uint64_t binningKey(std::uint64_t cellKey, std::uint16_t attribute, bool kinds) {
+  if (!kinds) return (cellKey << 16) | attribute;
+  const std::uint64_t narrow = (std::uint64_t(attribute) * 16383 + 32767) / 65535;  // rounded to 14 bits
+  return ((cellKey & kCellKeyMask) << 16) | (narrow << 2) | (cellKey >> kKindShift);
+}
 
 /// One encoded brick, ready for FrameWriter::addBrick.
 struct EncodedBrick {
   glm::uvec3 coord;
   std::uint32_t particles = 0;
   std::uint32_t cells = 0;
+  std::array<std::uint32_t, kParticleKindCount> kindCells{};  ///< cells of each kind (with kinds)
   std::vector<std::byte> payload;
 };
 
-/// Sorts `keys` (full 64-bit keys, attribute included) by brick, groups them and encodes each
-/// brick; calls `sink` in ascending Morton order. `scratch` is resized to keys.size().
-/// Memory: keys + scratch + one batch of compressed payloads.
-void binKeys(KeyVector& keys, KeyVector& scratch, const KeyGrid& grid, bool attribute,
+/// Sorts `keys` (full 64-bit keys, binningKey) by brick, groups them and encodes each brick, with
+/// a kind per cell when `kinds`; calls `sink` in ascending Morton order. `scratch` is resized to
+/// keys.size(). Memory: keys + scratch + one batch of compressed payloads.
+void binKeys(KeyVector& keys, KeyVector& scratch, const KeyGrid& grid, bool attribute, bool kinds,
              int zstdLevel, const std::function<void(EncodedBrick&&)>& sink);
 
 }  // namespace flipscope::detail

@@ -204,15 +204,18 @@ class FrameBinner {
       : mGrid(grid),
         mKind(kind),
         mAttribute(kind != AttributeKind::None),
+        mKinds(grid.header.particleKinds),
         mPlan(plan),
         mOptions(options),
         mScratch(std::move(scratchDir)),
         mPrefix(std::string(kSpillPrefix) + std::to_string(::getpid()) + "-" + std::to_string(frame)) {}
 
+  /// With particle kinds, the chunk's last column holds the type flags (convertFrame).
   void add(const ParticleChunk& chunk) {
+    const AttributeColumn* types = mKinds ? &chunk.attributes.back() : nullptr;
     if (mSpill) {
       mBatch.clear();
-      account(detail::computeKeys(chunk, mGrid, mKind, mBatch));
+      account(detail::computeKeys(chunk, mGrid, mKind, mBatch, types));
       mSpill->add(mBatch.cellKeys.data(), mBatch.values.data(), mBatch.cellKeys.size());
       return;
     }
@@ -220,7 +223,7 @@ class FrameBinner {
       mKeys.cellKeys.reserve(mPlan.maxBinParticles + mPlan.chunkParticles);
       if (mAttribute) mKeys.values.reserve(mPlan.maxBinParticles + mPlan.chunkParticles);
     }
-    account(detail::computeKeys(chunk, mGrid, mKind, mKeys));
+    account(detail::computeKeys(chunk, mGrid, mKind, mKeys, types));
     if (mKeys.cellKeys.size() > mPlan.maxBinParticles) startSpilling();
   }
 
@@ -289,13 +292,14 @@ class FrameBinner {
     const float lo = mStats.attributeMin, hi = mStats.attributeMax;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, keys.size(), 1 << 16), [&](const auto& range) {
       for (std::size_t i = range.begin(); i != range.end(); ++i)
-        keys[i] = (keys[i] << 16) | (mAttribute ? detail::quantizeAttribute(values[i], lo, hi) : 0);
+        keys[i] = detail::binningKey(keys[i], mAttribute ? detail::quantizeAttribute(values[i], lo, hi) : 0, mKinds);
     });
     detail::ValueVector().swap(values);
     detail::KeyVector scratch;
-    detail::binKeys(keys, scratch, mGrid, mAttribute, mOptions.zstdLevel, [&](detail::EncodedBrick&& brick) {
+    detail::binKeys(keys, scratch, mGrid, mAttribute, mKinds, mOptions.zstdLevel, [&](detail::EncodedBrick&& brick) {
       writer.addBrick(brick.coord, brick.particles, brick.cells, brick.payload);
       mStats.particles += brick.particles;
+      for (std::size_t k = 0; k < kParticleKindCount; ++k) mStats.kindCells[k] += brick.kindCells[k];
       stopPoint("brick");
     });
     detail::KeyVector().swap(keys);
@@ -304,6 +308,7 @@ class FrameBinner {
   const KeyGrid& mGrid;
   AttributeKind mKind;
   bool mAttribute;
+  bool mKinds;
   MemoryPlan mPlan;
   const ConvertOptions& mOptions;
   std::filesystem::path mScratch;
@@ -316,11 +321,93 @@ class FrameBinner {
   std::uint32_t mSpillBuckets = 0;
 };
 
+std::unique_ptr<ParticleSource> joined(std::vector<std::unique_ptr<ParticleSource>> parts) {
+  if (parts.size() == 1) return std::move(parts.front());
+  return concatSources(std::move(parts));
+}
+
 std::unique_ptr<ParticleSource> openFrame(const FrameInput& input, const ReadOptions& read) {
   std::vector<std::unique_ptr<ParticleSource>> parts;
   for (const auto& file : input.files) parts.push_back(openParticleFile(file, read));
-  if (parts.size() == 1) return std::move(parts.front());
-  return concatSources(std::move(parts));
+  return joined(std::move(parts));
+}
+
+/// One file of a frame binned into a store with particle kinds: its chunks end in a column of
+/// the particles' type flags, the file's kind attribute `kindName`, or all 0 (liquid) for a file
+/// without one (kindName empty). `asked`: kindName was read for the types alone, as the last
+/// column (else it is the stored attribute too, and copied).
+class TypedSource final : public ParticleSource {
+ public:
+  TypedSource(std::unique_ptr<ParticleSource> inner, std::string kindName, bool asked)
+      : mInner(std::move(inner)), mKindName(std::move(kindName)), mAsked(asked) {}
+  std::string name() const override { return mInner->name(); }
+  std::string format() const override { return mInner->format(); }
+  std::vector<AttributeDesc> attributes() const override { return mInner->attributes(); }
+  bool hasVelocity() const override { return mInner->hasVelocity(); }
+  std::optional<std::uint64_t> countHint() const override { return mInner->countHint(); }
+  std::optional<SpacingHint> spacingHint() const override { return mInner->spacingHint(); }
+  std::optional<std::string> kindAttribute() const override { return mInner->kindAttribute(); }
+  void rewind() override { mInner->rewind(); }
+  bool read(ParticleChunk& chunk, std::size_t maxParticles) override {
+    if (!mInner->read(chunk, maxParticles)) return false;
+    if (mAsked) {
+      FLIPSCOPE_CHECK(!chunk.attributes.empty() && chunk.attributes.back().name == mKindName, mKindName);
+      return true;
+    }
+    AttributeColumn types{mKindName, 1, {}};
+    if (mKindName.empty()) {
+      types.values.assign(chunk.size(), 0.0f);
+    } else {
+      auto column = std::find_if(chunk.attributes.begin(), chunk.attributes.end(),
+                                 [&](const AttributeColumn& c) { return c.name == mKindName; });
+      FLIPSCOPE_CHECK(column != chunk.attributes.end(), mKindName);
+      types.values = column->values;
+    }
+    chunk.attributes.push_back(std::move(types));
+    return true;
+  }
+
+ private:
+  std::unique_ptr<ParticleSource> mInner;
+  std::string mKindName;
+  bool mAsked;
+};
+
+/// Per input, per file: the attribute holding the particles' types (empty: none, liquid).
+using KindAttributes = std::vector<std::vector<std::string>>;
+
+/// A frame for convertFrame into a store with particle kinds (`kinds` of its files), else as
+/// openFrame.
+std::unique_ptr<ParticleSource> openTypedFrame(const FrameInput& input, const ReadOptions& read, bool storeKinds,
+                                               const std::vector<std::string>& kinds) {
+  if (!storeKinds) return openFrame(input, read);
+  std::vector<std::unique_ptr<ParticleSource>> parts;
+  for (std::size_t f = 0; f < input.files.size(); ++f) {
+    const std::string& kind = kinds[f];
+    ReadOptions typed = read;
+    const bool asked =
+        !kind.empty() && std::find(read.attributes.begin(), read.attributes.end(), kind) == read.attributes.end();
+    if (asked) typed.attributes.push_back(kind);
+    parts.push_back(std::make_unique<TypedSource>(openParticleFile(input.files[f], typed), kind, asked));
+  }
+  return joined(std::move(parts));
+}
+
+/// The kind attribute of `part` (a file) as ConvertOptions::kindAttribute asks (empty: none).
+/// Throws FileError for a named attribute that is not one integer a particle.
+std::string kindAttributeOf(const std::optional<std::string>& asked, const ParticleSource& part) {
+  if (!asked) return part.kindAttribute().value_or("");
+  if (*asked == "none") return "";
+  for (const AttributeDesc& a : part.attributes())
+    if (a.name == *asked) {
+      if (!isIntegerType(a.type) || a.arity != 1)
+        throw FileError(part.name(), "--kind-attribute: attribute '" + a.name + "' is " +
+                                         std::string(valueTypeName(a.type)) +
+                                         (a.arity == 1 ? "" : " x" + std::to_string(a.arity)) +
+                                         ", not one integer a particle (Mantaflow's type flags)");
+      return a.name;
+    }
+  return "";
 }
 
 /// The input files for a message: the first three, then how many more.
@@ -672,6 +759,9 @@ FrameReport convertOneFrame(ParticleSource& source, BrickStore& store, int frame
   FrameBinner binner(grid, kind, plan, options, scratch, frame);
   ParticleChunk chunk;
   while (source.read(chunk, plan.chunkParticles)) {
+    const std::size_t storedColumns = kind == AttributeKind::Scalar || kind == AttributeKind::Magnitude ? 1 : 0;
+    if (header.particleKinds && (chunk.attributes.size() != storedColumns + 1 || chunk.attributes.back().arity != 1))
+      throw FileError(source.name(), "was read without the column of particle types that the store keeps");
     if (kind == AttributeKind::Scalar || kind == AttributeKind::Magnitude) {
       // The source must have been opened with ReadOptions::attributes = {the store's attribute}.
       if (chunk.attributes.empty() || chunk.attributes.front().name != header.attributeName)
@@ -746,13 +836,34 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
   bool allVelocity = true;
   std::uint64_t hinted = 0;
   std::vector<std::vector<AttributeDesc>> held;  // with a name asked for: what each input holds
+  KindAttributes kindAttributes;
+  bool kinds = false;
+  std::vector<AttributeDesc> firstHeld;  // what the first file holds: for a kind attribute no file has
   for (const auto& input : inputs) {
-    auto source = openFrame(input, probe);
+    std::vector<std::unique_ptr<ParticleSource>> parts;
+    kindAttributes.emplace_back();
+    for (const auto& file : input.files) {
+      parts.push_back(openParticleFile(file, probe));
+      kindAttributes.back().push_back(kindAttributeOf(options.kindAttribute, *parts.back()));
+      kinds = kinds || !kindAttributes.back().back().empty();
+      if (&input == &inputs.front() && &file == &input.files.front()) firstHeld = parts.back()->attributes();
+    }
+    auto source = joined(std::move(parts));
     allVelocity = allVelocity && source->hasVelocity();
     hinted += source->countHint().value_or(0);
     if (byName) held.push_back(source->attributes());
   }
   StoredAttribute attribute = chooseAttribute(options.attribute, inputs, held, probe, allVelocity);
+  const bool kindsByName = options.kindAttribute && *options.kindAttribute != "none";
+  if (kindsByName && options.kindAttribute->empty())
+    throw InputError("--kind-attribute: an attribute name, auto or none, not ''");
+  if (kindsByName && !kinds) {
+    std::string names;
+    for (const auto& a : firstHeld) names += (names.empty() ? "" : ", ") + a.name;
+    throw FileError(inputs.front().files.front(),
+                    "has no attribute '" + *options.kindAttribute + "' (--kind-attribute), nor has any other input (" +
+                        (names.empty() ? std::string("it holds positions only") : "it holds: " + names) + ")");
+  }
 
   ConvertReport report;
   StoreDirectory directory(storeDir);
@@ -801,6 +912,15 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
             ", not " + (attribute.kind == AttributeKind::None ? std::string("none") : "'" + attribute.name + "'") +
             " (--attribute); convert into a new store to keep another");
       attribute = kept;
+      if (kinds && !header.particleKinds) {
+        if (kindsByName)
+          throw InputError(storeDir.string() + ": the store has no particle kinds (store version " +
+                           std::to_string(header.version) + "), not '" + *options.kindAttribute +
+                           "' (--kind-attribute); convert into a new store to keep them");
+        report.warnings.push_back(storeDir.string() +
+                                  ": the store has no particle kinds; the inputs' kinds are not kept");
+      }
+      kinds = header.particleKinds;
       report.cellSizeOrigin = "kept from the existing store";
       report.spacingOrigin = "the existing store";
     } else if (directory.alone()) {
@@ -841,6 +961,7 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
                          "domain (give --domain)");
     }
     header = chooseHeader(bounds, options, attribute, spacing, report);
+    header.particleKinds = kinds;
   }
   std::optional<FramelessHeader> framelessHeader;
   std::optional<BrickStore> created;
@@ -862,7 +983,7 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     progress.setLabel("convert frame " + std::to_string(inputs[i].frame) + " (" + std::to_string(i + 1) + "/" +
                       std::to_string(inputs.size()) + ")");
-    auto source = openFrame(inputs[i], reading.read);
+    auto source = openTypedFrame(inputs[i], reading.read, kinds, kindAttributes[i]);
     report.frames.push_back(convertOneFrame(*source, store, inputs[i].frame, reading, &progress,
                                             framelessHeader ? &*framelessHeader : nullptr));
     framelessHeader.reset();  // kept: the store has a frame

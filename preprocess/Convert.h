@@ -15,6 +15,11 @@
 // Oddities are counted, reported (FrameStats) and skipped: NaN/Inf coordinates, particles
 // outside `domain`.
 //
+// Particle kinds (ParticleKind.h): a store has them (StoreHeader::particleKinds) when an input
+// file of the convert carries a kind attribute (ConvertOptions::kindAttribute); a cell's kind is
+// the smallest of its particles', and the particles of a file without a kind attribute are
+// liquid (Mantaflow's FLIP file beside its secondary particles).
+//
 // Cell size: --cell-size, else longest domain axis / --resolution, else (neither given) one cell
 // per particle spacing of the first frame (ParticleSpacing.h), falling back to
 // kDefaultResolution cells along the longest axis, with a warning, when the spacing is unknown
@@ -80,6 +85,14 @@ struct ConvertOptions {
   /// "speed", the length of the velocity. A name an input lacks is a FileError naming the file
   /// and what it holds. Appending keeps the store's attribute; another one asked for is refused.
   std::optional<std::string> attribute;
+  /// The integer attribute that holds each particle's type, as Mantaflow's flags
+  /// (fromMantaflowType): unset (`auto`): what each file's conventions name
+  /// (ParticleSource::kindAttribute: Blender Mantaflow's `U` of `particles_secondary`); "none":
+  /// no kinds; or a name: that attribute, in every file that has it (an input that has none is
+  /// liquid). A name no input has, or one of a non-integer attribute, is a FileError naming the
+  /// file and the option. Appending keeps the store's kinds: a name given for a store without
+  /// kinds is refused, and the kinds `auto` finds then are dropped with a warning.
+  std::optional<std::string> kindAttribute;
   int zstdLevel = 1;
   std::filesystem::path scratchDir;    ///< spill files; default: the store directory
   /// Add to the store at storeDir, which must exist, with its header: also a store with no
@@ -143,7 +156,8 @@ struct StaleFiles {
 StaleFiles removeStaleFiles(const std::filesystem::path& dir, bool temporaries);
 
 /// Bins one frame read from `source` into `store` (lower-level step of convert()): writes its
-/// frame file, then lists it in the store's frame table.
+/// frame file, then lists it in the store's frame table. For a store with particle kinds, the
+/// last column of each chunk holds the particles' type flags (fromMantaflowType).
 FrameReport convertFrame(ParticleSource& source, BrickStore& store, int frame, const ConvertOptions& options,
                          Progress* progress = nullptr);
 

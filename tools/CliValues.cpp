@@ -109,6 +109,13 @@ DeviceChoice parseDeviceChoice(const std::string& option, const std::string& tex
   bad(option, text, "auto, gpu or cpu");
 }
 
+std::string describeKindCells(const std::array<std::uint64_t, kParticleKindCount>& cells) {
+  std::string text;
+  for (std::size_t k = 0; k < kParticleKindCount; ++k)
+    text += (k ? ", " : "") + std::string(particleKindName(ParticleKind(k))) + " " + std::to_string(cells[k]);
+  return text;
+}
+
 std::string describeAttribute(const StoreHeader& header) {
   switch (header.attribute) {
     case AttributeKind::None:

@@ -30,5 +30,7 @@ std::string formatBox(const Box& box);
 std::string formatNumber17(double value);
 /// "none", "speed (the length of the velocity)", "pscale (scalar)", "v (the length of a vector)".
 std::string describeAttribute(const StoreHeader& header);
+/// The cells of each particle kind: "liquid 120, foam 3, spray 40, bubble 0".
+std::string describeKindCells(const std::array<std::uint64_t, kParticleKindCount>& cells);
 
 }  // namespace flipscope::tools

@@ -26,6 +26,7 @@ struct ConvertArgs {
   std::string domain;
   std::string mem = "4G";
   std::string attribute = "auto";
+  std::string kindAttribute = "auto";
   int zstdLevel = 1;
   std::string scratch;
   bool append = false;
@@ -43,6 +44,7 @@ void runConvert(const ConvertArgs& a) {
   if (!a.domain.empty()) options.domain = parseBox("--domain", a.domain);
   options.memoryBudget = parseBytes("--mem", a.mem);
   if (a.attribute != "auto") options.attribute = a.attribute;
+  if (a.kindAttribute != "auto") options.kindAttribute = a.kindAttribute;
   options.zstdLevel = a.zstdLevel;
   options.scratchDir = a.scratch;
   options.append = a.append;
@@ -65,9 +67,9 @@ void runConvert(const ConvertArgs& a) {
                 h.brickGrid.z, describeAttribute(h).c_str());
     return;
   }
-  std::printf("store %s: cell size %g (%s), bricks of %u^3, grid %ux%ux%u bricks, attribute %s\n", a.store.c_str(),
+  std::printf("store %s: cell size %g (%s), bricks of %u^3, grid %ux%ux%u bricks, attribute %s%s\n", a.store.c_str(),
               h.cellSize, report.cellSizeOrigin.c_str(), h.brickSize, h.brickGrid.x, h.brickGrid.y, h.brickGrid.z,
-              describeAttribute(h).c_str());
+              describeAttribute(h).c_str(), h.particleKinds ? ", particle kinds" : "");
   if (h.particleSpacing > 0)
     std::printf("particle spacing %g (%.2f cells), from %s\n", h.particleSpacing, h.particleSpacing / h.cellSize,
                 report.spacingOrigin.c_str());
@@ -79,6 +81,7 @@ void runConvert(const ConvertArgs& a) {
                 f.seconds, f.spillBuckets ? " (out of core)" : "");
     if (h.attribute != AttributeKind::None && f.stats.particles > 0)
       std::printf("; %s %g to %g", h.attributeName.c_str(), f.stats.attributeMin, f.stats.attributeMax);
+    if (h.particleKinds) std::printf("; cells %s", describeKindCells(f.stats.kindCells).c_str());
     if (f.stats.skippedInvalid || f.stats.skippedOutside)
       std::printf("; skipped %llu NaN/Inf and %llu outside the domain", (unsigned long long)f.stats.skippedInvalid,
                   (unsigned long long)f.stats.skippedOutside);
@@ -114,6 +117,11 @@ void addConvertCommand(CLI::App& app) {
   cmd->add_option("--attribute", args->attribute,
                   "Per-particle attribute to store (16 bits): auto (speed when the inputs have velocities), none, "
                   "speed, or the name of an attribute of the inputs (a vector one by its length)")
+      ->capture_default_str();
+  cmd->add_option("--kind-attribute", args->kindAttribute,
+                  "Integer attribute holding each particle's type as Mantaflow's flags (2 spray, 4 bubble, 8 foam, "
+                  "else liquid), stored as a kind per cell: auto (Blender Mantaflow's U of particles_secondary), "
+                  "none, or an attribute name; inputs without it are liquid")
       ->capture_default_str();
   cmd->add_option("--zstd-level", args->zstdLevel, "zstd level of brick payloads")
       ->check(CLI::Range(-5, 19))

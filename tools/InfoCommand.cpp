@@ -67,7 +67,15 @@ void runInfo(const InfoArgs& a) {
     total.storeBytes += s.storeBytes;
     total.skippedInvalid += s.skippedInvalid;
     total.skippedOutside += s.skippedOutside;
+    for (std::size_t k = 0; k < kParticleKindCount; ++k) total.kindCells[k] += s.kindCells[k];
   }
+  // Cells of each particle kind: null in a store without kinds.
+  auto kindCells = [&](const FrameSummary& s) {
+    if (!h.particleKinds) return nlohmann::json(nullptr);
+    nlohmann::json cells;
+    for (std::size_t k = 0; k < kParticleKindCount; ++k) cells[particleKindName(ParticleKind(k))] = s.kindCells[k];
+    return cells;
+  };
   // The attribute's range over the frames (store.fsh records it since version 4).
   std::optional<AttributeRange> range;
   if (a.verify) {
@@ -101,6 +109,7 @@ void runInfo(const InfoArgs& a) {
     j["attribute"] = attribute ? h.attributeName : "none";
     j["attribute_kind"] = attributeKindName(h.attribute);
     j["attribute_range"] = range ? nlohmann::json::array({range->min, range->max}) : nlohmann::json(nullptr);
+    j["particle_kinds"] = h.particleKinds;
     j["store_id"] = storeIdText(h.id);
     j["frames_missing"] = missing;
     j["frames"] = nlohmann::json::array();
@@ -115,13 +124,15 @@ void runInfo(const InfoArgs& a) {
                              {"ratio_to_raw", s.ratioToRaw},
                              {"skipped_invalid", s.skippedInvalid},
                              {"skipped_outside", s.skippedOutside},
-                             {"attribute_range", frameRange(s)}});
+                             {"attribute_range", frameRange(s)},
+                             {"kind_cells", kindCells(s)}});
     }
     j["total"] = {{"particles", total.particles},
                   {"bricks", total.bricks},
                   {"bits_per_particle", bpp},
                   {"store_bytes", total.storeBytes},
-                  {"ratio_to_raw", ratio}};
+                  {"ratio_to_raw", ratio},
+                  {"kind_cells", kindCells(total)}};
     if (a.verify) {
       j["verified"] = damage.empty();
       j["damage"] = damage;
@@ -137,9 +148,14 @@ void runInfo(const InfoArgs& a) {
     else
       std::printf("spacing    particle spacing unknown (cell size %g)\n", h.cellSize);
     if (range)
-      std::printf("attribute  %s, %g to %g over the frames\n\n", describeAttribute(h).c_str(), range->min, range->max);
+      std::printf("attribute  %s, %g to %g over the frames\n", describeAttribute(h).c_str(), range->min, range->max);
     else
-      std::printf("attribute  %s\n\n", describeAttribute(h).c_str());
+      std::printf("attribute  %s\n", describeAttribute(h).c_str());
+    if (h.particleKinds)
+      std::printf("kinds      a particle kind per cell; cells over the frames: %s\n\n",
+                  describeKindCells(total.kindCells).c_str());
+    else
+      std::printf("kinds      none (every cell liquid)\n\n");
     std::printf("%7s %14s %9s %8s %10s %12s %9s\n", "frame", "particles", "bricks", "fill", "bits/part", "bytes",
                 "raw/store");
     for (const auto& s : frames)

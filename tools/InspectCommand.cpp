@@ -77,6 +77,8 @@ nlohmann::json inspectFile(const std::filesystem::path& path, bool headerOnly) {
   const auto declared = source->countHint();
   j["points_declared"] = declared ? nlohmann::json(*declared) : nlohmann::json(nullptr);
   j["velocity"] = source->hasVelocity();
+  const auto kind = source->kindAttribute();
+  j["kind_attribute"] = kind ? nlohmann::json(*kind) : nlohmann::json(nullptr);
 
   std::vector<Range> ranges(attributes.size());
   for (std::size_t a = 0; a < attributes.size(); ++a) {
@@ -183,6 +185,9 @@ void printFile(const nlohmann::json& j) {
     }
   }
   std::printf("  velocity    %s\n", j["velocity"].get<bool>() ? "yes (convert stores speed by default)" : "no");
+  if (!j["kind_attribute"].is_null())
+    std::printf("  kinds       %s: particle types (Mantaflow's flags), convert stores a kind per cell\n",
+                j["kind_attribute"].get<std::string>().c_str());
 }
 
 void runInspect(const InspectArgs& a) {

@@ -20,6 +20,8 @@ namespace flipscope {
 enum class ValueType : std::uint8_t { Int8, UInt8, Int16, UInt16, Int32, UInt32, Int64, UInt64, Float16, Float32, Float64 };
 /// "int8", "uint8", ..., "float16", "float32", "float64".
 std::string_view valueTypeName(ValueType type);
+/// Int8 .. UInt64.
+constexpr bool isIntegerType(ValueType type) { return type <= ValueType::UInt64; }
 
 /// A per-particle attribute that a file holds besides the positions (velocity included), as
 /// its header declares it: what `flipscope inspect` lists and `convert --attribute` chooses.
@@ -85,6 +87,11 @@ class ParticleSource {
   /// The particle spacing as the file's metadata tells it without reading the particles, else
   /// nullopt (then estimateParticleSpacing() measures neighbour distances).
   virtual std::optional<SpacingHint> spacingHint() const { return std::nullopt; }
+  /// The attribute of attributes() that holds each particle's type by the file's own
+  /// conventions (Mantaflow's type flags, preprocess/store/ParticleKind.h), else nullopt: Blender
+  /// Mantaflow's integer `U` of a points grid named `particles_secondary`. Of one file: a
+  /// concatenation of sources has none.
+  virtual std::optional<std::string> kindAttribute() const { return std::nullopt; }
 };
 
 struct ReadOptions {

@@ -991,6 +991,15 @@ class VdbPointsReader final : public ParticleSource {
     if (mSpacing.points == 0 || !(mSpacing.volume > 0) || !std::isfinite(mSpacing.volume)) return std::nullopt;
     return mSpacing;
   }
+  std::optional<std::string> kindAttribute() const override {
+    const bool secondary = std::any_of(mGrids.begin(), mGrids.end(),
+                                       [](const PointGrid& g) { return g.name == "particles_secondary"; });
+    const bool typed = std::any_of(mAttributes.begin(), mAttributes.end(), [](const AttributeDesc& a) {
+      return a.name == "U" && a.arity == 1 && isIntegerType(a.type);
+    });
+    if (secondary && typed) return std::string("U");
+    return std::nullopt;
+  }
 
   bool read(ParticleChunk& chunk, std::size_t maxParticles) override {
     FLIPSCOPE_CHECK(maxParticles > 0);

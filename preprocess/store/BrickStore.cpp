@@ -25,9 +25,11 @@ namespace {
 constexpr char kStoreMagic[8] = {'F', 'S', 'S', 'T', 'O', 'R', 'E', '1'};
 /// Fixed part of store.fsh: magic .. particle spacing, store id, run count; then 8 bytes a run
 /// of the frame table, then the checksum. Version 4 adds the attribute name (length and bytes)
-/// and the attribute range (flag, min, max) before the run count.
+/// and the attribute range (flag, min, max) before the run count, version 5 the particle kinds
+/// flag after them.
 constexpr std::size_t kStoreHeaderFixedBytes = 8 + 4 + 4 + 8 + 24 + 12 + 4 + 8 + 16 + 4;
 constexpr std::size_t kStoreHeaderV4Bytes = 4 + 4 + 4 + 4;
+constexpr std::size_t kStoreHeaderV5Bytes = 4;
 /// The footer's version field, counted back from the end of the file.
 constexpr std::uint64_t kFooterVersionFromEnd = 24;
 
@@ -80,6 +82,7 @@ class FileHandle {
   int mFd;
 };
 
+/// The footer in the layout of f.version.
 void serializeFooter(ByteWriter& w, const FrameFooter& f) {
   w.put(f.octreeOffset);
   w.put(f.octreeLevels);
@@ -92,12 +95,15 @@ void serializeFooter(ByteWriter& w, const FrameFooter& f) {
   w.put(f.stats.skippedOutside);
   w.put(f.stats.attributeMin);
   w.put(f.stats.attributeMax);
+  if (f.version >= 5)
+    for (std::uint64_t cells : f.stats.kindCells) w.put(cells);
   w.append(f.storeId.data(), f.storeId.size());
   w.put(f.version);
   w.put(f.reserved);
 }
 
-FrameFooter parseFooter(ByteReader& r) {
+/// A footer of `version` (read from its place first).
+FrameFooter parseFooter(ByteReader& r, std::uint32_t version) {
   FrameFooter f;
   f.octreeOffset = r.get<std::uint64_t>("footer octree offset");
   f.octreeLevels = r.get<std::uint32_t>("footer octree levels");
@@ -110,6 +116,10 @@ FrameFooter parseFooter(ByteReader& r) {
   f.stats.skippedOutside = r.get<std::uint64_t>("footer skipped outside");
   f.stats.attributeMin = r.get<float>("footer attribute min");
   f.stats.attributeMax = r.get<float>("footer attribute max");
+  static constexpr const char* kKindCellFields[kParticleKindCount] = {"footer liquid cells", "footer foam cells",
+                                                                      "footer spray cells", "footer bubble cells"};
+  if (version >= 5)
+    for (std::uint32_t k = 0; k < kParticleKindCount; ++k) f.stats.kindCells[k] = r.get<std::uint64_t>(kKindCellFields[k]);
   auto id = r.getBytes(f.storeId.size(), "footer store id");
   std::memcpy(f.storeId.data(), id.data(), f.storeId.size());
   f.version = r.get<std::uint32_t>("footer version");
@@ -191,6 +201,7 @@ std::string storeIdText(const StoreId& id) {
 std::vector<std::byte> serializeStoreHeader(const StoreHeader& h, const std::vector<int>& frames,
                                             const std::optional<AttributeRange>& range) {
   FLIPSCOPE_CHECK(h.attributeName.size() <= kMaxAttributeNameBytes, h.attributeName.size());
+  FLIPSCOPE_CHECK(!h.particleKinds || h.version >= 5, "particle kinds in a version " << h.version << " store");
   const bool v3 = h.version == 3;
   ByteWriter w;
   w.append(kStoreMagic, sizeof kStoreMagic);
@@ -213,6 +224,7 @@ std::vector<std::byte> serializeStoreHeader(const StoreHeader& h, const std::vec
     w.put(range ? range->min : 0.0f);
     w.put(range ? range->max : 0.0f);
   }
+  if (h.version >= 5) w.put(std::uint32_t(h.particleKinds ? 1 : 0));
   const auto runs = runsOf(frames);
   w.put(std::uint32_t(runs.size()));
   for (const FrameRun& run : runs) {
@@ -221,7 +233,7 @@ std::vector<std::byte> serializeStoreHeader(const StoreHeader& h, const std::vec
   }
   w.put(checksum64(w.view()));
   FLIPSCOPE_CHECK(w.size() == kStoreHeaderFixedBytes + (v3 ? 0 : kStoreHeaderV4Bytes + h.attributeName.size()) +
-                                  8 * runs.size() + 8,
+                                  (h.version >= 5 ? kStoreHeaderV5Bytes : 0) + 8 * runs.size() + 8,
                   w.size());
   return std::move(w.bytes());
 }
@@ -262,6 +274,11 @@ StoreHeader parseStoreHeader(std::span<const std::byte> bytes, const std::filesy
     values.max = r.get<float>("attribute range max");
     if (hasRange > 1) r.fail("attribute range flag", "neither 0 nor 1");
     if (hasRange) range = values;
+  }
+  if (h.version >= 5) {
+    const auto kinds = r.get<std::uint32_t>("particle kinds flag");
+    if (kinds > 1) r.fail("particle kinds flag", "neither 0 nor 1");
+    h.particleKinds = kinds == 1;
   }
   const auto runCount = r.get<std::uint32_t>("frame table runs");
   if (runCount > r.remaining() / 8) r.fail("frame table runs", "more runs than the file holds");
@@ -377,13 +394,14 @@ FrameIndex readFrameIndex(const std::filesystem::path& file, const StoreHeader& 
   readAt(handle.fd(), file, 0, magic, 8, "frame magic");
   if (std::memcmp(magic, kFrameMagic, 8) != 0) throw FileError(file, "at byte 0 (magic): not a flipscope frame file");
 
+  // The smallest footer first: its magic, and the version at the place every version keeps it
+  // (an old frame is named as one); then the footer of that version.
   std::vector<std::byte> footerBytes(kFrameFooterBytes);
-  const std::uint64_t footerOffset = size - kFrameFooterBytes;
+  std::uint64_t footerOffset = size - kFrameFooterBytes;
   readAt(handle.fd(), file, footerOffset, footerBytes.data(), footerBytes.size(), "footer");
   if (std::memcmp(footerBytes.data() + kFrameFooterBytes - 8, kFooterMagic, 8) != 0)
     throw FileError(file, "no frame footer at byte " + std::to_string(footerOffset) +
                               " (file truncated or corrupted)");
-  // The version first, at the place every version keeps it: an old frame is named as one.
   std::uint32_t version = 0;
   std::memcpy(&version, footerBytes.data() + kFrameFooterBytes - kFooterVersionFromEnd, 4);
   if (version != header.version)
@@ -391,15 +409,24 @@ FrameIndex readFrameIndex(const std::filesystem::path& file, const StoreHeader& 
                               std::to_string(header.version) + ", this flipscope reads versions " +
                               std::to_string(kOldestStoreVersion) + " to " + std::to_string(kStoreVersion) +
                               "); convert the particle files again into a new store");
-  ByteReader fr(std::span<const std::byte>(footerBytes).first(kFrameFooterBytes - 8), file, footerOffset);
-  FrameFooter footer = parseFooter(fr);
+  const std::uint64_t footerSize = frameFooterBytes(version);
+  if (size < sizeof kFrameMagic + footerSize)
+    throw FileError(file, "truncated: " + std::to_string(size) + " bytes, smaller than an empty frame of version " +
+                              std::to_string(version));
+  if (footerSize != kFrameFooterBytes) {
+    footerBytes.resize(footerSize);
+    footerOffset = size - footerSize;
+    readAt(handle.fd(), file, footerOffset, footerBytes.data(), footerBytes.size(), "footer");
+  }
+  ByteReader fr(std::span<const std::byte>(footerBytes).first(footerSize - 8), file, footerOffset);
+  FrameFooter footer = parseFooter(fr, version);
   // The index region runs from the octree to the checksum field; check sizes before reading.
   const std::uint64_t nodesBytes = 8ull * footer.nodeCount;
   const std::uint64_t tableBytes = 40ull * footer.brickCount;
   if (footer.octreeOffset < sizeof kFrameMagic || footer.tableOffset != footer.octreeOffset + nodesBytes ||
       footer.tableOffset + tableBytes != footerOffset)
     throw FileError(file, "footer offsets inconsistent with the file size (file truncated or corrupted)");
-  std::vector<std::byte> index(nodesBytes + tableBytes + kFrameFooterBytes - 16);
+  std::vector<std::byte> index(nodesBytes + tableBytes + footerSize - 16);
   readAt(handle.fd(), file, footer.octreeOffset, index.data(), index.size(), "octree and brick table");
   if (checksum64(index) != footer.indexChecksum)
     throw FileError(file, "index checksum mismatch: octree, brick table or footer corrupted");
@@ -419,7 +446,7 @@ FrameIndex readFrameIndex(const std::filesystem::path& file, const StoreHeader& 
   out.bricks.resize(footer.brickCount);
   std::vector<std::uint32_t> codes;
   codes.reserve(footer.brickCount);
-  std::uint64_t expectedOffset = sizeof kFrameMagic, particles = 0;
+  std::uint64_t expectedOffset = sizeof kFrameMagic, particles = 0, cells = 0;
   for (std::uint32_t i = 0; i < footer.brickCount; ++i) {
     BrickRecord& b = out.bricks[i];
     b.coord.x = r.get<std::uint32_t>("brick x");
@@ -439,12 +466,18 @@ FrameIndex readFrameIndex(const std::filesystem::path& file, const StoreHeader& 
       throw FileError(file, which + ": invalid particle or cell count");
     expectedOffset += b.bytes;
     particles += b.particles;
+    cells += b.cells;
     const std::uint32_t code = mortonEncode3(b.coord.x, b.coord.y, b.coord.z);
     if (!codes.empty() && code <= codes.back()) throw FileError(file, which + ": bricks out of Morton order");
     codes.push_back(code);
   }
   if (expectedOffset != footer.octreeOffset) throw FileError(file, "brick payloads do not end where the octree starts");
   if (particles != footer.stats.particles) throw FileError(file, "brick particle counts do not add up to the total");
+  std::uint64_t kindCells = 0;
+  for (std::uint64_t n : footer.stats.kindCells) kindCells += n;
+  if (kindCells != (header.particleKinds ? cells : 0))
+    throw FileError(file, header.particleKinds ? "the cells of each particle kind do not add up to the bricks' cells"
+                                               : "cells of particle kinds in a store without particle kinds");
   const std::uint32_t maxBricks = std::max({header.brickGrid.x, header.brickGrid.y, header.brickGrid.z});
   if (footer.octreeLevels != octreeLevelsFor(maxBricks) ||
       PresenceOctree::build(codes, maxBricks).nodes != out.octree.nodes)
@@ -511,6 +544,12 @@ BrickStore BrickStore::createOrAppend(const std::filesystem::path& dir, const St
                                  ? "another convert is creating this store with a different domain, cell size, "
                                    "brick size or attribute"
                                  : "existing store has a different domain, cell size, brick size or attribute");
+      if (h.particleKinds != header.particleKinds) {
+        const std::string theirs = h.particleKinds ? "has particle kinds" : "has no particle kinds";
+        const std::string ours = header.particleKinds ? "with particle kinds" : "without particle kinds";
+        throw FileError(dir, (store.incomplete() ? "another convert is creating this store, which " : "existing store ") +
+                                 theirs + ", but this one writes frames " + ours);
+      }
       return store;
     }
   }
@@ -643,7 +682,7 @@ std::vector<std::byte> BrickStore::readPayload(const FrameIndex& frame, std::uin
 DecodedBrick BrickStore::readBrick(const FrameIndex& frame, std::uint32_t brickIndex) const {
   auto payload = readPayload(frame, brickIndex);
   return decodeBrick(payload, frame.file, brickIndex, frame.bricks[brickIndex], mHeader.cellsPerBrick(),
-                     mHeader.attribute != AttributeKind::None);
+                     mHeader.attribute != AttributeKind::None, mHeader.particleKinds);
 }
 
 }  // namespace flipscope

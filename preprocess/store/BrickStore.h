@@ -5,7 +5,8 @@
 // A store is a directory:
 //   store.fsh               StoreHeader: format version, domain, cell size, brick size, particle
 //                           spacing, the store's random 128-bit id, the per-particle attribute
-//                           (its kind and name) and its range over the frames, and the frame table
+//                           (its kind and name) and its range over the frames, whether bricks
+//                           carry particle kinds (version 5), and the frame table
 //   frame_NNNNNN.fsf        one file per frame: brick payloads, then octree, brick table, footer
 //   store.lock              the writers' locks (StoreLock.h); readers ignore it
 // Every file is written atomically (AtomicFile). The frame table in store.fsh lists the frames
@@ -44,6 +45,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "preprocess/store/ParticleKind.h"
 #include "preprocess/store/PresenceOctree.h"
 
 namespace flipscope {
@@ -51,9 +53,11 @@ namespace flipscope {
 /// 2: StoreHeader::particleSpacing. 3: the store id (in store.fsh and every frame footer) and
 /// the frame table. 4: the attribute's name (any attribute of the input files, not only speed)
 /// and the store's attribute range in store.fsh; frame files unchanged but for their version.
-/// Version 3 stores are read and appended to as version 3 (speed or no attribute; their range
-/// is gathered from the frames); older ones are refused (convert again).
-inline constexpr std::uint32_t kStoreVersion = 4;
+/// 5: StoreHeader::particleKinds in store.fsh, a kind per cell in the payloads of such stores,
+/// and FrameStats::kindCells in the frame footer (136 bytes, 104 before).
+/// Version 3 and 4 stores are read and appended to as what they are (no kinds; version 3: speed
+/// or no attribute, its range gathered from the frames); older ones are refused (convert again).
+inline constexpr std::uint32_t kStoreVersion = 5;
 inline constexpr std::uint32_t kOldestStoreVersion = 3;
 inline constexpr char kStoreHeaderName[] = "store.fsh";
 /// Frame numbers a store holds: 0 to kMaxFrame (six digits in the file name).
@@ -97,6 +101,9 @@ struct StoreHeader {
   double particleSpacing = 0;
   /// Made by BrickStore::createOrAppend for a new store (random unless given); frames carry it.
   StoreId id{};
+  /// Every brick carries a ParticleKind per occupied cell (DecodedBrick::kinds). Version 5 only.
+  /// convert quantizes the attribute of such stores to 14 bits (BrickBinning.h).
+  bool particleKinds = false;
 
   glm::dvec3 domainMax() const { return origin + glm::dvec3(brickGrid) * double(brickSize) * cellSize; }
   std::uint32_t cellsPerBrick() const { return brickSize * brickSize * brickSize; }
@@ -120,6 +127,9 @@ struct FrameStats {
   std::uint64_t skippedOutside = 0;   ///< outside the store's domain
   float attributeMin = 0;             ///< attribute value of quantized 0
   float attributeMax = 0;             ///< attribute value of quantized 65535
+  /// Occupied cells of each kind (index: ParticleKind), summed over the bricks; all zero in a
+  /// store without particle kinds, and not stored before version 5.
+  std::array<std::uint64_t, kParticleKindCount> kindCells{};
 };
 
 /// A frame's index: everything but the payloads. Immutable once loaded.
@@ -135,20 +145,24 @@ struct FrameIndex {
 /// A brick's particles quantized to cells. Cells are linear indices inside the brick,
 /// x + brickSize * (y + brickSize * z), strictly ascending. counts[i] >= 1 particles fell into
 /// cells[i]. attributes (empty if the store has none) has one 16-bit value per particle,
-/// grouped by cell in the order of `cells`, ascending within a cell.
+/// grouped by cell in the order of `cells`, ascending within a cell. kinds (empty if the store
+/// has no particle kinds) has the kind of each cell, in the order of `cells`.
 struct DecodedBrick {
   std::vector<std::uint32_t> cells;
   std::vector<std::uint32_t> counts;
   std::vector<std::uint16_t> attributes;
+  std::vector<ParticleKind> kinds;
   std::uint64_t particleCount() const;
 };
 
 /// Payload codec (exposed for tests and the streaming benchmark).
 std::vector<std::byte> encodeBrick(const DecodedBrick& brick, int zstdLevel);
 /// Throws FileError naming `file` and `brickIndex` on any malformation; checks `expected`
-/// particle and cell counts and that every cell index is < cellsPerBrick.
+/// particle and cell counts, that every cell index is < cellsPerBrick and, with `hasKinds`,
+/// that every kind is < kParticleKindCount.
 DecodedBrick decodeBrick(std::span<const std::byte> payload, const std::filesystem::path& file, std::uint32_t brickIndex,
-                         const BrickRecord& expected, std::uint32_t cellsPerBrick, bool hasAttribute);
+                         const BrickRecord& expected, std::uint32_t cellsPerBrick, bool hasAttribute,
+                         bool hasKinds);
 
 class BrickStore {
  public:
@@ -161,7 +175,8 @@ class BrickStore {
   enum class FramelessStore { Replace, Join };
   /// Creates a new store directory with `header` (its id, or a random one when it is all
   /// zero), or, if a store with frames exists (or one without, to join), checks that its header
-  /// matches (same brick size, cell size, origin, grid, attribute) and opens it for appending.
+  /// matches (same brick size, cell size, origin, grid, attribute, particle kinds) and opens it
+  /// for appending (a version 3 or 4 store stays one: no particle kinds).
   /// Under the table lock (StoreLock.h), so concurrent writers agree on one store.
   /// `created`, when given, says whether this call wrote store.fsh.
   static BrickStore createOrAppend(const std::filesystem::path& dir, const StoreHeader& header,
@@ -217,13 +232,13 @@ class BrickStore {
 /// the footer's store id is not header.id (a frame of another store).
 FrameIndex readFrameIndex(const std::filesystem::path& file, const StoreHeader& header);
 
-/// store.fsh: the header, the attribute range (version 4) and the frame table (frames ascending,
-/// unique, 0..kMaxFrame; stored as runs of consecutive frames), in the layout of header.version
-/// (3, or 4 for every other version).
+/// store.fsh: the header, the attribute range (since version 4), the particle kinds flag (since
+/// version 5) and the frame table (frames ascending, unique, 0..kMaxFrame; stored as runs of
+/// consecutive frames), in the layout of header.version (3, 4 or 5).
 std::vector<std::byte> serializeStoreHeader(const StoreHeader& header, const std::vector<int>& frames = {},
                                             const std::optional<AttributeRange>& range = std::nullopt);
 /// Throws FileError on any truncation, corruption, unknown version or trailing bytes. The frame
-/// table goes to `frames` and the attribute range (version 4; nullopt for version 3) to `range`
+/// table goes to `frames` and the attribute range (since version 4; nullopt for 3) to `range`
 /// when given.
 StoreHeader parseStoreHeader(std::span<const std::byte> bytes, const std::filesystem::path& file,
                              std::vector<int>* frames = nullptr, std::optional<AttributeRange>* range = nullptr);

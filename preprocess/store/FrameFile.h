@@ -16,10 +16,12 @@ namespace flipscope {
 
 inline constexpr char kFrameMagic[8] = {'F', 'S', 'F', 'R', 'A', 'M', 'E', '1'};
 inline constexpr char kFooterMagic[8] = {'F', 'S', 'F', 'O', 'O', 'T', 'R', '1'};
+/// The smallest footer (versions 3 and 4); version 5 adds FrameStats::kindCells.
 inline constexpr std::uint64_t kFrameFooterBytes = 104;
+constexpr std::uint64_t frameFooterBytes(std::uint32_t version) { return version >= 5 ? 136 : kFrameFooterBytes; }
 
-/// The last kFrameFooterBytes of a frame file. The version sits at the same distance from the
-/// end of the file in every version, so that an old frame is named as such.
+/// The last frameFooterBytes(version) of a frame file. The version sits at the same distance
+/// from the end of the file in every version, so that an old frame is named as such.
 struct FrameFooter {
   std::uint64_t octreeOffset = 0;
   std::uint32_t octreeLevels = 0;
@@ -27,7 +29,7 @@ struct FrameFooter {
   std::uint64_t tableOffset = 0;
   std::uint32_t brickCount = 0;
   std::int32_t frame = 0;
-  FrameStats stats;
+  FrameStats stats;                 ///< kindCells since version 5
   StoreId storeId{};                ///< the id of the store the frame belongs to (since version 3)
   std::uint32_t version = kStoreVersion;  ///< the store's; 24 bytes before the end in every version
   std::uint32_t reserved = 0;

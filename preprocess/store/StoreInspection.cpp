@@ -24,6 +24,7 @@ FrameSummary summarizeFrame(const FrameIndex& frame, const StoreHeader& header) 
   s.ratioToRaw = s.storeBytes ? 12.0 * double(s.particles) / double(s.storeBytes) : 0;
   s.attributeMin = frame.stats.attributeMin;
   s.attributeMax = frame.stats.attributeMax;
+  s.kindCells = frame.stats.kindCells;
   return s;
 }
 
@@ -49,15 +50,27 @@ std::vector<std::string> checkFrameTable(const BrickStore& store) {
 std::vector<std::string> verifyFrame(const BrickStore& store, const FrameIndex& frame) {
   std::vector<std::string> errors;
   std::mutex mutex;
+  std::array<std::uint64_t, kParticleKindCount> kindCells{};
+  bool decoded = true;  // every brick: only then are the kind counts complete
   tbb::parallel_for(std::size_t(0), frame.bricks.size(), [&](std::size_t i) {
     try {
-      store.readBrick(frame, std::uint32_t(i));
+      const DecodedBrick brick = store.readBrick(frame, std::uint32_t(i));
+      std::array<std::uint64_t, kParticleKindCount> cells{};
+      for (ParticleKind kind : brick.kinds) ++cells[std::size_t(kind)];
+      std::lock_guard lock(mutex);
+      for (std::size_t k = 0; k < kParticleKindCount; ++k) kindCells[k] += cells[k];
     } catch (const FileError& e) {
       std::lock_guard lock(mutex);
       errors.push_back(e.what());
+      decoded = false;
     }
   });
   std::sort(errors.begin(), errors.end());
+  for (std::size_t k = 0; decoded && k < kParticleKindCount; ++k)
+    if (kindCells[k] != frame.stats.kindCells[k])
+      errors.push_back(frame.file.string() + ": the bricks hold " + std::to_string(kindCells[k]) + " " +
+                       particleKindName(ParticleKind(k)) + " cells, the footer says " +
+                       std::to_string(frame.stats.kindCells[k]));
   return errors;
 }
 

@@ -1,6 +1,7 @@
 // What `flipscope info` reports about a BrickStore, as library calls.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -22,6 +23,7 @@ struct FrameSummary {
   double ratioToRaw = 0;       ///< raw float32 xyz bytes (12 per particle) / store bytes
   float attributeMin = 0;      ///< the frame's attribute range (FrameStats)
   float attributeMax = 0;
+  std::array<std::uint64_t, kParticleKindCount> kindCells{};  ///< FrameStats::kindCells
 };
 
 FrameSummary summarizeFrame(const FrameIndex& frame, const StoreHeader& header);
@@ -37,8 +39,9 @@ std::string incompleteStoreReason();
 /// naming the file. Empty when every listed frame is there.
 std::vector<std::string> checkFrameTable(const BrickStore& store);
 
-/// Reads every brick of `frame`, checks its checksum and decodes it. Returns one message per
-/// damaged brick (naming the file and the brick); empty when the frame is intact. Parallel.
+/// Reads every brick of `frame`, checks its checksum and decodes it, and that the cells of each
+/// particle kind add up to the footer's. Returns one message per damaged brick (naming the file
+/// and the brick) or wrong count; empty when the frame is intact. Parallel.
 std::vector<std::string> verifyFrame(const BrickStore& store, const FrameIndex& frame);
 
 }  // namespace flipscope

@@ -256,12 +256,16 @@ TEST(FuzzCorpus, Write) {
   ASSERT_EQ(testing::runFlipscope("synth -o s.ply --particles 1k --velocity", tmp.path()).exitCode, 0);
   struct Store {
     const char* name;
-    const char* options;
+    std::string options;
   };
-  for (const Store& store : {Store{"speed32", "--resolution 24 --brick-size 32"},
-                             Store{"none64", "--resolution 48 --brick-size 64 --attribute none"}}) {
+  // And Blender Mantaflow's FLIP and secondary files: a store with particle kinds.
+  const std::string flipAndSecondary = "'" + (mantaflow.parent_path() / "data" / "fluid_data_0030.vdb").string() +
+                                       "' '" + (mantaflow / "fluid_particles_0030.vdb").string() + "'";
+  for (const Store& store : {Store{"speed32", "s.ply --resolution 24 --brick-size 32"},
+                             Store{"none64", "s.ply --resolution 48 --brick-size 64 --attribute none"},
+                             Store{"kinds32", flipAndSecondary + " --resolution 24 --brick-size 32 --attribute none"}}) {
     const auto run =
-        testing::runFlipscope(std::string("convert s.ply -o ") + store.name + " -q " + store.options, tmp.path());
+        testing::runFlipscope("convert " + store.options + " -o " + store.name + " -q", tmp.path());
     ASSERT_EQ(run.exitCode, 0) << run.output;
     const auto header = bytesOf(tmp / store.name / kStoreHeaderName);
     writeSeed(corpus / "store_header" / (std::string(store.name) + ".fsh"), header);
@@ -306,6 +310,40 @@ TEST(FuzzCorpus, Write) {
             corpus / "brick_payload" /
                 ("b" + std::to_string(brickSize) + (attribute ? "_speed" : "") + (rawForm ? "_raw" : "") + ".seed"),
             seed);
+      }
+    }
+
+  // Brick payloads with a kind per cell (flag 16; a generator of their own, so that the seeds
+  // above stay as they are).
+  std::mt19937 kindRng(13);
+  for (std::uint32_t sizeIndex = 0; sizeIndex < 2; ++sizeIndex)
+    for (bool attribute : {false, true}) {
+      const std::uint32_t brickSize = 32u << sizeIndex, cells = brickSize * brickSize * brickSize;
+      DecodedBrick brick;
+      for (std::uint32_t cell = kindRng() % 50; cell < cells; cell += 1 + std::uint32_t(kindRng() % 3000)) {
+        brick.cells.push_back(cell);
+        brick.counts.push_back(1 + std::uint32_t(kindRng() % 9));
+        brick.kinds.push_back(kindRng() % 2 ? ParticleKind::Liquid : ParticleKind(kindRng() % kParticleKindCount));
+        for (std::uint32_t i = 0; attribute && i < brick.counts.back(); ++i)
+          brick.attributes.push_back(std::uint16_t(kindRng()));
+      }
+      const std::vector<std::byte> payload = encodeBrick(brick, 3);
+      for (bool rawForm : {false, true}) {
+        std::vector<std::byte> body = payload;
+        if (rawForm) {
+          body.resize(ZSTD_getFrameContentSize(payload.data(), payload.size()));
+          ASSERT_EQ(ZSTD_decompress(body.data(), body.size(), payload.data(), payload.size()), body.size());
+        }
+        std::vector<std::byte> seed(9);
+        const auto particles = std::uint32_t(brick.particleCount()), occupied = std::uint32_t(brick.cells.size());
+        std::memcpy(seed.data(), &particles, 4);
+        std::memcpy(seed.data() + 4, &occupied, 4);
+        seed[8] = std::byte(std::uint8_t((attribute ? 1 : 0) | sizeIndex << 1 | (rawForm ? 8 : 0) | 16));
+        seed.insert(seed.end(), body.begin(), body.end());
+        writeSeed(corpus / "brick_payload" /
+                      ("b" + std::to_string(brickSize) + (attribute ? "_speed" : "") + "_kinds" +
+                       (rawForm ? "_raw" : "") + ".seed"),
+                  seed);
       }
     }
 

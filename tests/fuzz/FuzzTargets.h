@@ -15,7 +15,8 @@
 //                           is and again with its checksum made right, then every brick decoded
 //   brick_payload           u32 particles, u32 cells, u8 flags (bit 0: attribute, bits 1-2:
 //                           brick size 32 / 64 / 128, bit 3: the rest is the raw payload, which
-//                           the target compresses; else it is the zstd payload), then the payload
+//                           the target compresses; else it is the zstd payload; bit 4: a kind
+//                           per cell), then the payload
 //   camera                  camera JSON
 #pragma once
 
@@ -130,8 +131,12 @@ inline Result storeHeader(std::span<const std::byte> input) {
 /// table and the footer before it) made right, found through the footer's octree offset.
 inline void fixIndexChecksum(std::vector<std::byte>& bytes) {
   if (bytes.size() < kFrameFooterBytes + 8) return;
+  std::uint32_t version = 0;  // 24 bytes before the end in every version
+  std::memcpy(&version, bytes.data() + bytes.size() - 24, 4);
+  const std::uint64_t footerBytes = frameFooterBytes(version);
+  if (bytes.size() < footerBytes + 8) return;
   std::uint64_t octreeOffset = 0;
-  std::memcpy(&octreeOffset, bytes.data() + bytes.size() - kFrameFooterBytes, 8);
+  std::memcpy(&octreeOffset, bytes.data() + bytes.size() - footerBytes, 8);
   if (octreeOffset > bytes.size() - 16) return;
   const std::uint64_t sum = checksum64(bytes.data() + octreeOffset, bytes.size() - 16 - octreeOffset);
   std::memcpy(bytes.data() + bytes.size() - 16, &sum, 8);
@@ -185,7 +190,7 @@ inline Result frameIndex(std::span<const std::byte> input) {
         const BrickRecord& b = index.bricks[i];
         try {
           decodeBrick(bytes.subspan(b.offset, b.bytes), "frame", i, b, header.cellsPerBrick(),
-                      header.attribute != AttributeKind::None);
+                      header.attribute != AttributeKind::None, header.particleKinds);
         } catch (const FileError&) {
         }
       }
@@ -203,6 +208,7 @@ inline Result brickPayload(std::span<const std::byte> input) {
   std::memcpy(&record.cells, input.data() + 4, 4);
   const auto flags = std::uint8_t(input[8]);
   const bool attribute = flags & 1;
+  const bool kinds = flags & 16;
   const std::uint32_t brickSize = 32u << std::min((flags >> 1) & 3, 2);
   std::span<const std::byte> payload = input.subspan(kHeader);
   std::vector<std::byte> compressed;
@@ -215,13 +221,15 @@ inline Result brickPayload(std::span<const std::byte> input) {
   }
   record.bytes = std::uint32_t(payload.size());
   try {
-    const DecodedBrick brick = decodeBrick(payload, "brick", 0, record, brickSize * brickSize * brickSize, attribute);
+    const DecodedBrick brick =
+        decodeBrick(payload, "brick", 0, record, brickSize * brickSize * brickSize, attribute, kinds);
     if (brick.particleCount() != record.particles || brick.cells.size() != record.cells)
       throw LogicError("decodeBrick accepted a brick that does not match its record");
     // What decodes must encode to the same brick.
     const DecodedBrick again =
-        decodeBrick(encodeBrick(brick, 1), "brick", 0, record, brickSize * brickSize * brickSize, attribute);
-    if (again.cells != brick.cells || again.counts != brick.counts || again.attributes != brick.attributes)
+        decodeBrick(encodeBrick(brick, 1), "brick", 0, record, brickSize * brickSize * brickSize, attribute, kinds);
+    if (again.cells != brick.cells || again.counts != brick.counts || again.attributes != brick.attributes ||
+        again.kinds != brick.kinds)
       throw LogicError("encodeBrick(decodeBrick(payload)) decodes differently");
     return Result::Accepted;
   } catch (const FileError&) {

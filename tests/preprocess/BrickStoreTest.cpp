@@ -49,7 +49,7 @@ TEST(BrickCodec, RoundTripsRandomBricks) {
     BrickRecord r;
     r.cells = std::uint32_t(brick.cells.size());
     r.particles = std::uint32_t(brick.particleCount());
-    DecodedBrick back = decodeBrick(payload, "x.fsf", 3, r, 64 * 64 * 64, attribute);
+    DecodedBrick back = decodeBrick(payload, "x.fsf", 3, r, 64 * 64 * 64, attribute, false);
     EXPECT_EQ(back.cells, brick.cells);
     EXPECT_EQ(back.counts, brick.counts);
     EXPECT_EQ(back.attributes, brick.attributes);
@@ -64,13 +64,13 @@ TEST(BrickCodec, RejectsWrongCountsAndGarbage) {
   r.cells = std::uint32_t(brick.cells.size());
   r.particles = std::uint32_t(brick.particleCount()) + 1;
   try {
-    decodeBrick(payload, "f.fsf", 9, r, 32 * 32 * 32, false);
+    decodeBrick(payload, "f.fsf", 9, r, 32 * 32 * 32, false, false);
     FAIL() << "accepted a wrong particle count";
   } catch (const FileError& e) {
     EXPECT_NE(std::string(e.what()).find("f.fsf: brick 9"), std::string::npos) << e.what();
   }
   std::vector<std::byte> garbage(64, std::byte{0x5a});
-  EXPECT_THROW(decodeBrick(garbage, "f.fsf", 0, r, 32 * 32 * 32, false), FileError);
+  EXPECT_THROW(decodeBrick(garbage, "f.fsf", 0, r, 32 * 32 * 32, false, false), FileError);
 }
 
 TEST(StoreHeader, RoundTripsAndRejectsEveryCorruption) {

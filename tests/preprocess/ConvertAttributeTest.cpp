@@ -243,14 +243,14 @@ TEST(ConvertAttribute, VersionThreeStoresAreReadAndAppendedToAsVersionThree) {
   EXPECT_EQ(range->min, std::min(back.frame(0)->stats.attributeMin, back.frame(3)->stats.attributeMin));
   EXPECT_EQ(range->max, std::max(back.frame(0)->stats.attributeMax, back.frame(3)->stats.attributeMax));
   EXPECT_EQ(storedValues(back, 3).size(), 40u);
-  // A version 3 frame file in a version 4 store is refused, naming both versions.
-  StoreHeader v4 = header;
-  v4.version = kStoreVersion;
+  // A version 3 frame file in a version 5 store is refused, naming both versions.
+  StoreHeader v5 = header;
+  v5.version = kStoreVersion;
   try {
-    readFrameIndex(back.framePath(0), v4);
+    readFrameIndex(back.framePath(0), v5);
     FAIL();
   } catch (const FileError& e) {
-    EXPECT_NE(std::string(e.what()).find("unsupported frame version 3 (the store is version 4"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("unsupported frame version 3 (the store is version 5"), std::string::npos)
         << e.what();
   }
 }

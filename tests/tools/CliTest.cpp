@@ -71,7 +71,8 @@ TEST_F(Cli, DefaultConvertOfMantaflowMakesOneCellPerParticleSpacingAndInfoShowsI
   EXPECT_LT(spacing, 0.05);
   EXPECT_EQ(spacing, j["cell_size"].get<double>());
   EXPECT_DOUBLE_EQ(j["particle_spacing_cells"].get<double>(), 1.0);
-  EXPECT_EQ(j["version"].get<std::uint32_t>(), 4u);
+  EXPECT_EQ(j["version"].get<std::uint32_t>(), 5u);
+  EXPECT_EQ(j["particle_kinds"], false) << "a FLIP file alone";
 
   CommandRun text = run("info " + path("store"));
   ASSERT_EQ(text.exitCode, 0) << text.output;
