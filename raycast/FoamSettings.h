@@ -28,6 +28,9 @@ struct FoamSettings {
   float extinction = 0.5f;
   float step = 1.0f;          ///< march step in cells (the density varies over 4^3 blocks)
   float opacityStop = 0.95f;  ///< the ray ends in foam this opaque (§3.5)
+  /// Stores with particle kinds: bubbles lie inside the liquid and are not rendered (--bubbles
+  /// hide, the default); shown, they are particles like the liquid's.
+  bool hideBubbles = true;
 
   bool classifies() const { return mode != FoamMode::Keep && source != FoamSource::Kind; }
   bool usesKinds() const { return mode != FoamMode::Keep && source != FoamSource::Classify; }

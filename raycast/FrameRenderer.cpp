@@ -68,6 +68,8 @@ StreamerOptions streamerOptions(const StoreHeader& header, const RenderSettings&
   options.conversion.overlap = storedOverlap(settings);
   options.conversion.attribute =
       header.attribute == AttributeKind::None ? AttributeReduction::None : AttributeReduction::Max;
+  options.conversion.hideBubbles = header.particleKinds && settings.foam.hideBubbles;
+  options.conversion.foamKinds = header.particleKinds && settings.foam.usesKinds();
   options.mipDilation = reach;
   options.threads = settings.threads ? settings.threads : std::max(1u, std::thread::hardware_concurrency());
   options.cacheBytes = settings.cpuCacheBytes;

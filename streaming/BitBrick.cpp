@@ -122,33 +122,56 @@ std::size_t BitBrick::bytes() const {
          attributes.size() * 2;
 }
 
-std::size_t BrickCells::bytes() const { return bits.size() * 8 + wordRank.size() * 4 + cellAttributes.size() * 2; }
+std::size_t BrickCells::bytes() const {
+  return bits.size() * 8 + wordRank.size() * 4 + cellAttributes.size() * 2 + foamKinds.size() * 8;
+}
 
 BrickCells makeBrickCells(const DecodedBrick& brick, std::uint32_t brickSize, AttributeReduction reduction) {
+  ConversionOptions options;
+  options.brickSize = brickSize;
+  options.attribute = reduction;
+  return makeBrickCells(brick, options);
+}
+
+BrickCells makeBrickCells(const DecodedBrick& brick, const ConversionOptions& options) {
+  const std::uint32_t brickSize = options.brickSize;
   FLIPSCOPE_CHECK(isBrickSize(brickSize), "brickSize=" << brickSize);
   FLIPSCOPE_CHECK(brick.counts.size() == brick.cells.size(),
                   "counts=" << brick.counts.size() << " cells=" << brick.cells.size());
+  const bool kinds = !brick.kinds.empty();
+  FLIPSCOPE_CHECK(!kinds || brick.kinds.size() == brick.cells.size(),
+                  "kinds=" << brick.kinds.size() << " cells=" << brick.cells.size());
+  const auto hidden = [&](std::size_t i) { return kinds && options.hideBubbles && brick.kinds[i] == ParticleKind::Bubble; };
+  const auto foam = [&](std::size_t i) {
+    return kinds && (brick.kinds[i] == ParticleKind::Foam || brick.kinds[i] == ParticleKind::Spray);
+  };
   const std::uint64_t cellsPerBrick = std::uint64_t(brickSize) * brickSize * brickSize;
   BrickCells out;
   out.brickSize = brickSize;
   out.bits.assign(cellsPerBrick / 64 + 1, 0);
+  if (options.foamKinds && kinds) out.foamKinds.assign(out.bits.size(), 0);
   if (!brick.cells.empty())
     FLIPSCOPE_CHECK(brick.cells.back() < cellsPerBrick, "last cell " << brick.cells.back() << " >= " << cellsPerBrick);
   // Cells ascend: gather each word in a register and store it once.
   std::uint64_t word = 0, wordIndex = 0;
   std::int64_t previous = -1;
-  for (std::uint32_t cell : brick.cells) {
+  std::size_t keptCells = 0;
+  for (std::size_t i = 0; i < brick.cells.size(); ++i) {
+    const std::uint32_t cell = brick.cells[i];
     FLIPSCOPE_CHECK(std::int64_t(cell) > previous, "cells not ascending: " << cell << " after " << previous);
+    previous = cell;
+    if (hidden(i)) continue;
+    ++keptCells;
     if ((cell >> 6) != wordIndex) {
       out.bits[wordIndex] = word;
       word = 0;
       wordIndex = cell >> 6;
     }
     word |= std::uint64_t(1) << (cell & 63);
-    previous = cell;
+    if (!out.foamKinds.empty() && foam(i)) out.foamKinds[cell >> 6] |= std::uint64_t(1) << (cell & 63);
   }
   out.bits[wordIndex] |= word;
-  if (reduction == AttributeReduction::None) return out;
+  if (options.attribute == AttributeReduction::None) return out;
 
   out.wordRank.resize(out.bits.size());
   std::uint32_t rank = 0;
@@ -158,7 +181,7 @@ BrickCells makeBrickCells(const DecodedBrick& brick, std::uint32_t brickSize, At
   }
   FLIPSCOPE_CHECK(brick.attributes.size() == brick.particleCount(),
                   "attributes=" << brick.attributes.size() << " particles=" << brick.particleCount());
-  out.cellAttributes.resize(brick.cells.size());
+  out.cellAttributes.reserve(keptCells);
   std::size_t particle = 0;
   for (std::size_t i = 0; i < brick.cells.size(); ++i) {
     std::uint32_t count = brick.counts[i];
@@ -169,37 +192,34 @@ BrickCells makeBrickCells(const DecodedBrick& brick, std::uint32_t brickSize, At
       sum += brick.attributes[particle];
       largest = std::max(largest, brick.attributes[particle]);
     }
-    out.cellAttributes[i] = reduction == AttributeReduction::Max ? largest : std::uint16_t(sum / count);
+    if (hidden(i)) continue;
+    out.cellAttributes.push_back(options.attribute == AttributeReduction::Max ? largest : std::uint16_t(sum / count));
   }
   return out;
 }
 
-BitBrick convertBrick(const Neighbourhood<BrickCells>& cells, const ConversionOptions& options) {
-  validate(options);
-  FLIPSCOPE_CHECK(cells[kCentre] != nullptr, "the centre brick is missing");
-  const bool withAttributes = options.attribute != AttributeReduction::None;
-  for (const BrickCells* c : cells) {
-    if (!c) continue;
-    FLIPSCOPE_CHECK(c->brickSize == options.brickSize,
-                    "brickSize=" << c->brickSize << " expected " << options.brickSize);
-    FLIPSCOPE_CHECK(!withAttributes || !c->wordRank.empty(), "a neighbour was built without attributes");
-  }
+// The sub-bricks of `bitset` (bits, or foamKinds) of the centre of `cells`, with its border:
+// the stored rows [-n, B+n) assembled from the 3x3x3 neighbourhood, scattered by nibbles.
+namespace {
+std::vector<glm::uvec4> assembleSubBricks(const Neighbourhood<BrickCells>& cells, const ConversionOptions& options,
+                                          std::vector<std::uint64_t> BrickCells::*bitset) {
   const std::uint32_t brickSize = options.brickSize, overlap = options.overlap;
   const std::uint32_t stored = brickSize + 2 * overlap;
-  BitBrick out;
-  out.brickSize = brickSize;
-  out.overlap = overlap;
-  const glm::uvec3 dims = out.subBrickDims();
-  out.subBricks.assign(std::size_t(dims.x) * dims.y * dims.z, glm::uvec4(0));
-  auto* words = reinterpret_cast<std::uint32_t*>(out.subBricks.data());
+  const glm::uvec3 dims = bitBrickSubBrickDims(brickSize, overlap);
+  std::vector<glm::uvec4> subBricks(std::size_t(dims.x) * dims.y * dims.z, glm::uvec4(0));
+  auto* words = reinterpret_cast<std::uint32_t*>(subBricks.data());
+  // A brick's bitset, or nullptr where the brick is absent or has none (no foam kinds).
+  const auto bitsOf = [&](int neighbour) -> const std::uint64_t* {
+    const BrickCells* c = cells[neighbour];
+    return c && !(c->*bitset).empty() ? (c->*bitset).data() : nullptr;
+  };
 
   // Stored row (sy, sz), x in [0, stored <= 144) as three words, from up to three bricks.
   auto buildRow = [&](std::uint32_t sy, std::uint32_t sz, std::uint64_t* row) {
     AxisSplit y = splitAxis(int(sy) - int(overlap), int(brickSize));
     AxisSplit z = splitAxis(int(sz) - int(overlap), int(brickSize));
     const std::uint64_t rowStart = (std::uint64_t(z.local) * brickSize + y.local) * brickSize;
-    if (const BrickCells* c = cells[neighbourIndex(0, y.offset, z.offset)]) {
-      const std::uint64_t* words = c->bits.data();
+    if (const std::uint64_t* words = bitsOf(neighbourIndex(0, y.offset, z.offset))) {
       if (brickSize == 32) {
         row[0] |= rowBits(words, rowStart, 32) << overlap;
       } else {
@@ -208,10 +228,10 @@ BitBrick convertBrick(const Neighbourhood<BrickCells>& cells, const ConversionOp
       }
     }
     if (overlap == 0) return;
-    if (const BrickCells* c = cells[neighbourIndex(-1, y.offset, z.offset)])
-      row[0] |= rowBits(c->bits.data(), rowStart + brickSize - overlap, overlap);
-    if (const BrickCells* c = cells[neighbourIndex(1, y.offset, z.offset)])
-      insertBits(row, overlap + brickSize, rowBits(c->bits.data(), rowStart, overlap), overlap);
+    if (const std::uint64_t* words = bitsOf(neighbourIndex(-1, y.offset, z.offset)))
+      row[0] |= rowBits(words, rowStart + brickSize - overlap, overlap);
+    if (const std::uint64_t* words = bitsOf(neighbourIndex(1, y.offset, z.offset)))
+      insertBits(row, overlap + brickSize, rowBits(words, rowStart, overlap), overlap);
   };
   // Word w of the sub-bricks in row (b, c) holds 8 stored rows: nibble k is row
   // (4b + (k&3), 8c + 2w + (k>>2)). Each word is written once, from registers.
@@ -238,9 +258,37 @@ BitBrick convertBrick(const Neighbourhood<BrickCells>& cells, const ConversionOp
           for (std::uint32_t j = 0; j < count; ++j) target[4 * (a0 + j)] = std::uint32_t(m[j & 7] >> (32 * (j >> 3)));
         }
       }
+  return subBricks;
+}
+}  // namespace
+
+BitBrick convertBrick(const Neighbourhood<BrickCells>& cells, const ConversionOptions& options) {
+  validate(options);
+  FLIPSCOPE_CHECK(cells[kCentre] != nullptr, "the centre brick is missing");
+  const bool withAttributes = options.attribute != AttributeReduction::None;
+  for (const BrickCells* c : cells) {
+    if (!c) continue;
+    FLIPSCOPE_CHECK(c->brickSize == options.brickSize,
+                    "brickSize=" << c->brickSize << " expected " << options.brickSize);
+    FLIPSCOPE_CHECK(!withAttributes || !c->wordRank.empty(), "a neighbour was built without attributes");
+  }
+  BitBrick out;
+  out.brickSize = options.brickSize;
+  out.overlap = options.overlap;
+  out.subBricks = assembleSubBricks(cells, options, &BrickCells::bits);
   if (withAttributes) fillAttributes(out, cells);
   return out;
 }
+
+std::vector<glm::uvec4> convertFoamKinds(const Neighbourhood<BrickCells>& cells, const ConversionOptions& options) {
+  bool any = false;
+  for (const BrickCells* c : cells)
+    if (c && !c->foamKinds.empty())
+      for (std::uint64_t w : c->foamKinds) any |= w != 0;
+  if (!any) return {};
+  return assembleSubBricks(cells, options, &BrickCells::foamKinds);
+}
+
 
 BitBrick convertBrick(const Neighbourhood<DecodedBrick>& bricks, const ConversionOptions& options) {
   validate(options);
@@ -248,7 +296,7 @@ BitBrick convertBrick(const Neighbourhood<DecodedBrick>& bricks, const Conversio
   Neighbourhood<BrickCells> cells{};
   for (int i = 0; i < 27; ++i) {
     if (!bricks[i]) continue;
-    built[i] = makeBrickCells(*bricks[i], options.brickSize, options.attribute);
+    built[i] = makeBrickCells(*bricks[i], options);
     cells[i] = &built[i];
   }
   return convertBrick(cells, options);

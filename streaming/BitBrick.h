@@ -37,6 +37,11 @@ struct ConversionOptions {
   std::uint32_t brickSize = 64;  ///< cells per brick edge: 32, 64 or 128
   std::uint32_t overlap = 4;     ///< border cells per side, <= kMaxOverlap; >= sphere radius + jitter
   AttributeReduction attribute = AttributeReduction::None;
+  /// Stores with particle kinds (DecodedBrick::kinds): drop the cells whose kind is Bubble (they
+  /// lie inside the liquid), and gather the cells whose kind is Foam or Spray in
+  /// BrickCells::foamKinds (for convertFoamKinds).
+  bool hideBubbles = false;
+  bool foamKinds = false;
 };
 /// Throws InputError naming the option when `options` is out of range.
 void validate(const ConversionOptions& options);
@@ -69,6 +74,9 @@ struct BrickCells {
   std::vector<std::uint64_t> bits;            ///< bit x + B*(y + B*z); one padding word at the end
   std::vector<std::uint32_t> wordRank;        ///< set bits before each word (with attributes only)
   std::vector<std::uint16_t> cellAttributes;  ///< reduced value per occupied cell, in cell order
+  /// The cells of `bits` whose kind is Foam or Spray, in its layout; empty without (no kinds, or
+  /// ConversionOptions::foamKinds off).
+  std::vector<std::uint64_t> foamKinds;
 
   bool isSet(std::uint32_t linearCell) const { return (bits[linearCell >> 6] >> (linearCell & 63)) & 1u; }
   std::size_t bytes() const;
@@ -78,6 +86,8 @@ struct BrickCells {
 /// attributes match the counts when `reduction` is not None (FLIPSCOPE_CHECK: the store's
 /// decoder has validated the file already).
 BrickCells makeBrickCells(const DecodedBrick& brick, std::uint32_t brickSize, AttributeReduction reduction);
+/// The same with the kind options of `options` (hideBubbles, foamKinds).
+BrickCells makeBrickCells(const DecodedBrick& brick, const ConversionOptions& options);
 
 /// The 3x3x3 bricks around a centre: index (dx+1) + 3*(dy+1) + 9*(dz+1), centre at 13;
 /// nullptr where a neighbour is empty or absent.
@@ -89,6 +99,9 @@ inline constexpr int neighbourIndex(int dx, int dy, int dz) { return (dx + 1) + 
 /// Converts the centre of `cells` (must not be nullptr) into a BitBrick. Every non-null entry
 /// must have options.brickSize (and attributes when options.attribute is not None).
 BitBrick convertBrick(const Neighbourhood<BrickCells>& cells, const ConversionOptions& options);
+/// The foam kinds of the centre of `cells` (BrickCells::foamKinds) as sub-bricks in the layout
+/// of convertBrick's, or empty when no brick of the neighbourhood has a foam or spray cell.
+std::vector<glm::uvec4> convertFoamKinds(const Neighbourhood<BrickCells>& cells, const ConversionOptions& options);
 /// Simple call: builds the BrickCells of every non-null brick, then converts.
 BitBrick convertBrick(const Neighbourhood<DecodedBrick>& bricks, const ConversionOptions& options);
 

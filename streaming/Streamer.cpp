@@ -162,8 +162,7 @@ std::shared_ptr<const BrickCells> Streamer::cellsOf(const BrickKey& key) {
   std::shared_ptr<const DecodedBrick> brick = mSource->read(key);
   std::shared_ptr<const BrickCells> cells;
   if (brick)
-    cells = std::make_shared<const BrickCells>(
-        makeBrickCells(*brick, mOptions.conversion.brickSize, mOptions.conversion.attribute));
+    cells = std::make_shared<const BrickCells>(makeBrickCells(*brick, mOptions.conversion));
   mCells.insert(key, cells, cells ? cells->bytes() : sizeof(BrickKey));
   return cells;
 }
@@ -184,6 +183,7 @@ std::shared_ptr<const ConvertedBrick> Streamer::convert(const BrickKey& key) {
   auto brick = std::make_shared<ConvertedBrick>();
   brick->key = key;
   brick->bits = convertBrick(cells, mOptions.conversion);
+  if (mOptions.conversion.foamKinds) brick->foamKinds = convertFoamKinds(cells, mOptions.conversion);
   brick->mipmap = buildBrickMipmap(brick->bits, mOptions.mipDilation);
   return brick;
 }

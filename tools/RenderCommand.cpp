@@ -27,6 +27,7 @@ struct RenderArgs {
   std::string size = "1280x720";
   std::string camera;
   std::string cameraFile;
+  std::string saveCamera;
   std::string up = "y";
   std::optional<float> radius;
   std::string smoothing = "rof";
@@ -41,6 +42,7 @@ struct RenderArgs {
   std::string foam = "volume";
   std::string foamFrom = "both";
   float foamThreshold = 0.2f;
+  std::string bubbles = "hide";
   std::string gpuMem = "1G";
   std::string cpuMem = "2G";
   std::string device = "auto";
@@ -124,12 +126,16 @@ void runRender(const RenderArgs& a) {
   job.settings.foam.mode = parseFoamMode(a.foam);
   job.settings.foam.source = parseFoamSource(a.foamFrom);
   job.settings.foam.threshold = a.foamThreshold;
+  if (a.bubbles != "hide" && a.bubbles != "show")
+    throw InputError("--bubbles: unknown value '" + a.bubbles + "'; valid values: hide, show");
+  job.settings.foam.hideBubbles = a.bubbles == "hide";
   job.settings.gpuBudgetBytes = parseBytes("--gpu-mem", a.gpuMem);
   job.settings.cpuCacheBytes = parseBytes("--cpu-mem", a.cpuMem);
   job.settings.maxPasses = a.maxPasses;
   validate(job.settings);
   if (!a.camera.empty()) job.camera = parseCamera("--camera", a.camera);
   if (!a.cameraFile.empty()) job.camera = loadCamera(a.cameraFile);
+  job.saveCamera = a.saveCamera;
   job.up = parseUpAxis("--up", a.up);
   job.device = parseDeviceChoice("--device", a.device);
   job.quiet = a.quiet;
@@ -156,6 +162,7 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--size", args->size, "Image size WxH")->capture_default_str();
   auto* camera = cmd->add_option("--camera", args->camera, "ex,ey,ez,tx,ty,tz,ux,uy,uz,fov (world units, degrees)");
   cmd->add_option("--camera-file", args->cameraFile, "JSON {\"eye\", \"target\", \"up\", \"fov\"}")->excludes(camera);
+  cmd->add_option("--save-camera", args->saveCamera, "Write the camera of the render to this JSON file (--camera-file reads it)");
   cmd->add_option("--up", args->up, "Up axis of the default camera framed on the data (x, y or z)")
       ->capture_default_str();
   cmd->add_option("--radius", args->radius,
@@ -188,6 +195,9 @@ void addRenderCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--foam-threshold", args->foamThreshold,
                   "A cell is foam when fewer than this fraction of the cells within the sphere radius are set (0..1)")
+      ->capture_default_str();
+  cmd->add_option("--bubbles", args->bubbles,
+                  "Stores with particle kinds: hide (the bubbles inside the liquid) or show (as particles)")
       ->capture_default_str();
   cmd->add_option("--gpu-mem", args->gpuMem, "Brick pool budget on the device")->capture_default_str();
   cmd->add_option("--cpu-mem", args->cpuMem, "Converted-brick cache in CPU memory")->capture_default_str();

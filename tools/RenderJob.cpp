@@ -101,6 +101,7 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
   } else {
     camera = defaultRenderCamera(renderer.source(), first, last, settings.width, settings.height, job.up);
   }
+  if (!job.saveCamera.empty()) saveCamera(job.saveCamera, camera);
 
   std::vector<RenderedFile> files;
   for (int f = first; f <= last; ++f) {

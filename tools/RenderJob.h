@@ -27,6 +27,7 @@ struct RenderJob {
   std::optional<bool> colorByAttribute;
   std::optional<Camera> camera;  ///< default: framed on the frames' bricks
   glm::dvec3 up{0, 1, 0};        ///< up axis of the default camera
+  std::string saveCamera;        ///< where to write the camera used (--save-camera); empty: nowhere
   DeviceChoice device = DeviceChoice::Auto;
   bool quiet = false;
 };
