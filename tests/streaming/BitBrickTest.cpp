@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <optional>
 #include <random>
 
 #include "core/Error.h"
@@ -157,6 +158,79 @@ TEST(ConvertBrick, RejectsCellsOutsideTheBrick) {
   bad.cells = {5, 32768};
   bad.counts = {1, 1};
   EXPECT_THROW(makeBrickCells(bad, 32, AttributeReduction::None), LogicError);
+}
+
+}  // namespace
+}  // namespace flipscope
+
+namespace flipscope {
+namespace {
+
+// The kind of `cell` (neighbourhood coordinates) and whether it is occupied, by binary search.
+std::optional<ParticleKind> oracleKind(const Neighbourhood<DecodedBrick>& bricks, glm::ivec3 cell, int brickSize) {
+  glm::ivec3 offset(0), local = cell;
+  for (int a = 0; a < 3; ++a) {
+    if (cell[a] < 0) offset[a] = -1;
+    if (cell[a] >= brickSize) offset[a] = 1;
+    local[a] = cell[a] - offset[a] * brickSize;
+  }
+  const DecodedBrick* brick = bricks[neighbourIndex(offset.x, offset.y, offset.z)];
+  if (!brick) return std::nullopt;
+  const std::uint32_t linear = std::uint32_t(local.x + brickSize * (local.y + brickSize * local.z));
+  auto found = std::lower_bound(brick->cells.begin(), brick->cells.end(), linear);
+  if (found == brick->cells.end() || *found != linear) return std::nullopt;
+  return brick->kinds[std::size_t(found - brick->cells.begin())];
+}
+
+TEST(ConvertBrick, KindsHideBubblesAndGatherFoamAcrossTheBorder) {
+  std::mt19937 rng(77);
+  constexpr std::uint32_t kSize = 32, kOverlap = 4;
+  std::array<DecodedBrick, 27> storage;
+  Neighbourhood<DecodedBrick> bricks{};
+  for (int i = 0; i < 27; ++i) {
+    storage[i] = testing::randomBrick(rng, kSize, 0.3);
+    storage[i].kinds.resize(storage[i].cells.size());
+    for (ParticleKind& kind : storage[i].kinds) kind = ParticleKind(rng() % kParticleKindCount);
+    bricks[i] = &storage[i];
+  }
+  ConversionOptions options{kSize, kOverlap, AttributeReduction::Max};
+  options.hideBubbles = true;
+  options.foamKinds = true;
+  std::array<BrickCells, 27> cells;
+  Neighbourhood<BrickCells> around{};
+  for (int i = 0; i < 27; ++i) {
+    cells[i] = makeBrickCells(storage[i], options);
+    around[i] = &cells[i];
+  }
+  const BitBrick converted = convertBrick(around, options);
+  BitBrick foam = converted;
+  foam.subBricks = convertFoamKinds(around, options);
+  ASSERT_EQ(foam.subBricks.size(), converted.subBricks.size());
+  std::size_t hidden = 0, foamCells = 0;
+  const int lo = -int(kOverlap), hi = int(kSize + kOverlap);
+  for (int z = lo; z < hi; ++z)
+    for (int y = lo; y < hi; ++y)
+      for (int x = lo; x < hi; ++x) {
+        const glm::ivec3 cell(x, y, z);
+        const std::optional<ParticleKind> kind = oracleKind(bricks, cell, int(kSize));
+        const bool shown = kind && *kind != ParticleKind::Bubble;
+        hidden += kind && !shown;
+        ASSERT_EQ(converted.isSet(cell), shown) << x << "," << y << "," << z;
+        const bool isFoam = kind && (*kind == ParticleKind::Foam || *kind == ParticleKind::Spray);
+        foamCells += isFoam;
+        ASSERT_EQ(foam.isSet(cell), isFoam) << x << "," << y << "," << z;
+        if (shown) ASSERT_EQ(converted.attribute(cell), oracle(bricks, cell, int(kSize)).max) << x << "," << y << "," << z;
+      }
+  EXPECT_GT(hidden, 1000u);
+  EXPECT_GT(foamCells, 1000u);
+  EXPECT_EQ(converted.attributes.size(), converted.setCells());
+
+  // Without foam or spray anywhere there is nothing to upload.
+  for (int i = 0; i < 27; ++i) {
+    std::fill(storage[i].kinds.begin(), storage[i].kinds.end(), ParticleKind::Liquid);
+    cells[i] = makeBrickCells(storage[i], options);
+  }
+  EXPECT_TRUE(convertFoamKinds(around, options).empty());
 }
 
 }  // namespace

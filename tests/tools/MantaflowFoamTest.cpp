@@ -76,3 +76,34 @@ TEST(MantaflowFoam, FlipAndSecondaryParticlesShowTheLiquidSurface) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(MantaflowFoam, FoamSourceAndBubbleOptionsChangeTheImage) {
+  flipscope::testing::TempDir dir("mantaflow-foam-options");
+  const std::string store = (dir.path() / "store").string();
+  ASSERT_EQ(runFlipscope("convert " + kFlip + " " + kSecondary + " -o " + store + " -q").exitCode, 0);
+  const auto render = [&](const std::string& name, const std::string& options) {
+    const std::string image = (dir.path() / (name + ".exr")).string();
+    CommandRun r = runFlipscope("render " + store + " -o " + image + " --up z --size 160x90 -q " + options);
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    return flipscope::readExr(image).image;
+  };
+  const auto sum = [](const std::vector<float>& values) {
+    double s = 0;
+    for (float v : values) s += std::isfinite(v) ? v : 0;
+    return s;
+  };
+  double foamDifference = 0;
+  const auto kind = render("kind", "--foam-from kind"), classify = render("classify", "--foam-from classify");
+  for (std::size_t i = 0; i < kind.foam.size(); ++i) foamDifference += std::abs(kind.foam[i].a - classify.foam[i].a);
+  EXPECT_GT(foamDifference, 1.0) << "the stored kinds are not the classification";
+  // Bubbles lie inside the body: shown, they add to the liquid the thickness trace meets.
+  const auto hidden = render("hidden", "--foam keep"), shown = render("shown", "--foam keep --bubbles show");
+  EXPECT_GT(sum(shown.thickness), sum(hidden.thickness) * 1.01);
+  CommandRun bad = runFlipscope("render " + store + " -o " + (dir.path() / "x.png").string() + " --bubbles pop");
+  EXPECT_EQ(bad.exitCode, 2);
+  EXPECT_NE(bad.output.find("valid values: hide, show"), std::string::npos) << bad.output;
+}
+
+}  // namespace
