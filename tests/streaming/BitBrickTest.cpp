@@ -219,7 +219,9 @@ TEST(ConvertBrick, KindsHideBubblesAndGatherFoamAcrossTheBorder) {
         const bool isFoam = kind && (*kind == ParticleKind::Foam || *kind == ParticleKind::Spray);
         foamCells += isFoam;
         ASSERT_EQ(foam.isSet(cell), isFoam) << x << "," << y << "," << z;
-        if (shown) ASSERT_EQ(converted.attribute(cell), oracle(bricks, cell, int(kSize)).max) << x << "," << y << "," << z;
+        if (shown) {
+          ASSERT_EQ(converted.attribute(cell), oracle(bricks, cell, int(kSize)).max) << x << "," << y << "," << z;
+        }
       }
   EXPECT_GT(hidden, 1000u);
   EXPECT_GT(foamCells, 1000u);
