@@ -74,7 +74,9 @@ TEST(FoamGl, ScenesRenderAsTheCpuReferenceRendersThem) {
       }
     }
     EXPECT_LE(mismatch, 2u) << foamModeName(mode);
-    if (mode == FoamMode::Volume) EXPECT_GT(foamy, 200u);
+    if (mode == FoamMode::Volume) {
+      EXPECT_GT(foamy, 200u);
+    }
   }
 }
 
