@@ -17,6 +17,14 @@ vdb=tests/data/mantaflow-dam64/data/fluid_data_0030.vdb
 "$flipscope" render "$work/dam" -o "$out/mantaflow-spheres.png" --up z --size 640x360 --shading spheres -q
 "$flipscope" render "$work/dam" -o "$out/mantaflow-unsmoothed.png" --up z --size 640x360 --smoothing none -q
 
+# The same frame with Mantaflow's secondary particles (spray, foam, bubbles): foam as a volume
+# (the default), removed, and kept as spheres.
+secondary=tests/data/mantaflow-dam64/particles/fluid_particles_0030.vdb
+"$flipscope" convert "$vdb" "$secondary" -o "$work/dam-foam" -q
+"$flipscope" render "$work/dam-foam" -o "$out/mantaflow-foam-volume.png" --up z --size 640x360 -q
+"$flipscope" render "$work/dam-foam" -o "$out/mantaflow-foam-remove.png" --up z --size 640x360 --foam remove -q
+"$flipscope" render "$work/dam-foam" -o "$out/mantaflow-foam-keep.png" --up z --size 640x360 --foam keep -q
+
 # The five filters side by side on the same frame and camera.
 for filter in rof bilateral curvature-flow narrow-range plane-fit; do
   "$flipscope" render "$work/dam" -o "$out/filter-$filter.png" --up z --size 480x270 --smoothing "$filter" -q
