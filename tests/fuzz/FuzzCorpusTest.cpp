@@ -281,7 +281,26 @@ TEST(FuzzCorpus, Write) {
     }
   }
 
-  // Brick payloads: random bricks of each size, with and without attributes, in both forms.
+  // Brick payloads: random bricks of each size, with and without attributes (and kinds), in both
+  // forms: the fuzz target's 9-byte prefix (particles, cells, flags), then the payload.
+  const auto writePayloadSeeds = [&](const DecodedBrick& brick, std::uint32_t sizeIndex, std::uint8_t flags,
+                                     const std::string& name) {
+    const std::vector<std::byte> payload = encodeBrick(brick, 3);
+    for (bool rawForm : {false, true}) {
+      std::vector<std::byte> body = payload;
+      if (rawForm) {
+        body.resize(ZSTD_getFrameContentSize(payload.data(), payload.size()));
+        ASSERT_EQ(ZSTD_decompress(body.data(), body.size(), payload.data(), payload.size()), body.size());
+      }
+      std::vector<std::byte> seed(9);
+      const auto particles = std::uint32_t(brick.particleCount()), occupied = std::uint32_t(brick.cells.size());
+      std::memcpy(seed.data(), &particles, 4);
+      std::memcpy(seed.data() + 4, &occupied, 4);
+      seed[8] = std::byte(std::uint8_t(flags | sizeIndex << 1 | (rawForm ? 8 : 0)));
+      seed.insert(seed.end(), body.begin(), body.end());
+      writeSeed(corpus / "brick_payload" / (name + (rawForm ? "_raw" : "") + ".seed"), seed);
+    }
+  };
   std::mt19937 rng(7);
   for (std::uint32_t sizeIndex = 0; sizeIndex < 3; ++sizeIndex)
     for (bool attribute : {false, true}) {
@@ -293,24 +312,8 @@ TEST(FuzzCorpus, Write) {
         for (std::uint32_t i = 0; attribute && i < brick.counts.back(); ++i)
           brick.attributes.push_back(std::uint16_t(rng()));
       }
-      const std::vector<std::byte> payload = encodeBrick(brick, 3);
-      for (bool rawForm : {false, true}) {
-        std::vector<std::byte> body = payload;
-        if (rawForm) {
-          body.resize(ZSTD_getFrameContentSize(payload.data(), payload.size()));
-          ASSERT_EQ(ZSTD_decompress(body.data(), body.size(), payload.data(), payload.size()), body.size());
-        }
-        std::vector<std::byte> seed(9);
-        const auto particles = std::uint32_t(brick.particleCount()), occupied = std::uint32_t(brick.cells.size());
-        std::memcpy(seed.data(), &particles, 4);
-        std::memcpy(seed.data() + 4, &occupied, 4);
-        seed[8] = std::byte(std::uint8_t((attribute ? 1 : 0) | sizeIndex << 1 | (rawForm ? 8 : 0)));
-        seed.insert(seed.end(), body.begin(), body.end());
-        writeSeed(
-            corpus / "brick_payload" /
-                ("b" + std::to_string(brickSize) + (attribute ? "_speed" : "") + (rawForm ? "_raw" : "") + ".seed"),
-            seed);
-      }
+      writePayloadSeeds(brick, sizeIndex, attribute ? 1 : 0,
+                        "b" + std::to_string(brickSize) + (attribute ? "_speed" : ""));
     }
 
   // Brick payloads with a kind per cell (flag 16; a generator of their own, so that the seeds
@@ -327,24 +330,8 @@ TEST(FuzzCorpus, Write) {
         for (std::uint32_t i = 0; attribute && i < brick.counts.back(); ++i)
           brick.attributes.push_back(std::uint16_t(kindRng()));
       }
-      const std::vector<std::byte> payload = encodeBrick(brick, 3);
-      for (bool rawForm : {false, true}) {
-        std::vector<std::byte> body = payload;
-        if (rawForm) {
-          body.resize(ZSTD_getFrameContentSize(payload.data(), payload.size()));
-          ASSERT_EQ(ZSTD_decompress(body.data(), body.size(), payload.data(), payload.size()), body.size());
-        }
-        std::vector<std::byte> seed(9);
-        const auto particles = std::uint32_t(brick.particleCount()), occupied = std::uint32_t(brick.cells.size());
-        std::memcpy(seed.data(), &particles, 4);
-        std::memcpy(seed.data() + 4, &occupied, 4);
-        seed[8] = std::byte(std::uint8_t((attribute ? 1 : 0) | sizeIndex << 1 | (rawForm ? 8 : 0) | 16));
-        seed.insert(seed.end(), body.begin(), body.end());
-        writeSeed(corpus / "brick_payload" /
-                      ("b" + std::to_string(brickSize) + (attribute ? "_speed" : "") + "_kinds" +
-                       (rawForm ? "_raw" : "") + ".seed"),
-                  seed);
-      }
+      writePayloadSeeds(brick, sizeIndex, std::uint8_t((attribute ? 1 : 0) | 16),
+                        "b" + std::to_string(brickSize) + (attribute ? "_speed" : "") + "_kinds");
     }
 
   // Cameras.

@@ -18,16 +18,23 @@ struct OracleCell {
   std::uint16_t mean = 0, max = 0;
 };
 
-OracleCell oracle(const Neighbourhood<DecodedBrick>& bricks, glm::ivec3 cell, int brickSize) {
+/// The brick of the neighbourhood holding `cell` (nullptr when absent) and the cell's linear
+/// index inside it.
+std::pair<const DecodedBrick*, std::uint32_t> locate(const Neighbourhood<DecodedBrick>& bricks, glm::ivec3 cell,
+                                                     int brickSize) {
   glm::ivec3 offset(0), local = cell;
   for (int a = 0; a < 3; ++a) {
     if (cell[a] < 0) offset[a] = -1;
     if (cell[a] >= brickSize) offset[a] = 1;
     local[a] = cell[a] - offset[a] * brickSize;
   }
-  const DecodedBrick* brick = bricks[neighbourIndex(offset.x, offset.y, offset.z)];
+  return {bricks[neighbourIndex(offset.x, offset.y, offset.z)],
+          std::uint32_t(local.x + brickSize * (local.y + brickSize * local.z))};
+}
+
+OracleCell oracle(const Neighbourhood<DecodedBrick>& bricks, glm::ivec3 cell, int brickSize) {
+  const auto [brick, linear] = locate(bricks, cell, brickSize);
   if (!brick) return {};
-  std::uint32_t linear = std::uint32_t(local.x + brickSize * (local.y + brickSize * local.z));
   // Binary search and a particle prefix scan: no lookup code shared with the converter.
   auto found = std::lower_bound(brick->cells.begin(), brick->cells.end(), linear);
   if (found == brick->cells.end() || *found != linear) return {};
@@ -168,15 +175,8 @@ namespace {
 
 // The kind of `cell` (neighbourhood coordinates) and whether it is occupied, by binary search.
 std::optional<ParticleKind> oracleKind(const Neighbourhood<DecodedBrick>& bricks, glm::ivec3 cell, int brickSize) {
-  glm::ivec3 offset(0), local = cell;
-  for (int a = 0; a < 3; ++a) {
-    if (cell[a] < 0) offset[a] = -1;
-    if (cell[a] >= brickSize) offset[a] = 1;
-    local[a] = cell[a] - offset[a] * brickSize;
-  }
-  const DecodedBrick* brick = bricks[neighbourIndex(offset.x, offset.y, offset.z)];
+  const auto [brick, linear] = locate(bricks, cell, brickSize);
   if (!brick) return std::nullopt;
-  const std::uint32_t linear = std::uint32_t(local.x + brickSize * (local.y + brickSize * local.z));
   auto found = std::lower_bound(brick->cells.begin(), brick->cells.end(), linear);
   if (found == brick->cells.end() || *found != linear) return std::nullopt;
   return brick->kinds[std::size_t(found - brick->cells.begin())];
