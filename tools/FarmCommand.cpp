@@ -182,6 +182,7 @@ struct ConvertFarmArgs {
   std::uint32_t resolution = 0;
   std::uint32_t brickSize = 0;
   std::string attribute;
+  std::string kindAttribute;
   std::vector<std::string> grids;
   int zstdLevel = 1;
   std::string scratch;
@@ -225,6 +226,7 @@ void runFarmConvert(const ConvertFarmArgs& a) {
     };
     if (!a.domain.empty()) both("--domain", formatBox(parseBox("--domain", a.domain)));  // also clips, as convert does
     for (const auto& grid : a.grids) both("--grid", grid);
+    if (!a.kindAttribute.empty()) both("--kind-attribute", a.kindAttribute);
     if (!plan.resources.memory.empty()) both("--mem", convertBudget(plan.resources.memory));
     auto prepareOnly = [&](const std::string& option, const std::string& value) {
       plan.prepareArgs.insert(plan.prepareArgs.end(), {option, value});
@@ -366,6 +368,7 @@ void addFarmCommand(CLI::App& app) {
       ->excludes(cell);
   c->add_option("--brick-size", convert->brickSize, "Cells per brick edge")->check(CLI::IsMember({32, 64, 128}));
   c->add_option("--attribute", convert->attribute, "Per-particle attribute to store, as for convert");
+  c->add_option("--kind-attribute", convert->kindAttribute, "Particle type attribute (auto, none or a name), as for convert");
   c->add_option("--grid", convert->grids, "VDB: PointDataGrid names to read");
   c->add_option("--zstd-level", convert->zstdLevel, "zstd level of brick payloads")->check(CLI::Range(-5, 19));
   c->add_option("--scratch", convert->scratch,

@@ -87,6 +87,12 @@ TEST_F(FarmCommand, DryRunPrintsEveryScriptAndWritesNothing) {
   ASSERT_EQ(domain.exitCode, 0) << domain.output;
   EXPECT_EQ(domain.output.find("# bounds:"), std::string::npos) << domain.output;
   EXPECT_NE(domain.output.find("--prepare --domain 0,0,0,2,2,2"), std::string::npos) << domain.output;
+  // The particle type attribute goes to the header's convert and to every frame's.
+  const CommandRun kinds = runFlipscope("farm convert " + scenario.path("in/in_####.bin") + " -o " +
+                                        scenario.path("s") + " --kind-attribute none --dry-run");
+  ASSERT_EQ(kinds.exitCode, 0) << kinds.output;
+  EXPECT_NE(kinds.output.find("--prepare --domain \"$domain\" --kind-attribute none"), std::string::npos) << kinds.output;
+  EXPECT_NE(kinds.output.find("--append --kind-attribute none"), std::string::npos) << kinds.output;
 }
 
 TEST_F(FarmCommand, BadRequestsAreRefusedNamingWhatIsWrong) {
