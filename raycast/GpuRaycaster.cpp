@@ -118,27 +118,36 @@ void GpuRaycaster::classifyFoam(std::span<const std::uint32_t> slots, const Foam
     mOccupancyProgram = gl::Program::compute(gl::shaderSource("FoamOccupancy.comp"));
   }
   if (!mFoamParams.id()) mFoamParams = makeBuffer(sizeof(FoamClassifyParams));
-  mFoamParams.upload(0, &params, sizeof(params));
-  if (mBatch.size() < slots.size_bytes()) mBatch = makeBuffer(std::max<std::uint64_t>(slots.size_bytes(), 4096));
-  mBatch.upload(0, slots.data(), slots.size_bytes());
-  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  mFoamParams.bindBase(GL_UNIFORM_BUFFER, kParams);
-  mSubBricks.bindBase(GL_SHADER_STORAGE_BUFFER, kSubBricks);
-  mFoam.bindBase(GL_SHADER_STORAGE_BUFFER, kFoam);
-  mBatch.bindBase(GL_SHADER_STORAGE_BUFFER, kBatch);
-  mFoamOccupancy.bindBase(GL_SHADER_STORAGE_BUFFER, kFoamOccupancy);
+  // Bricks of the batch along y, in chunks that the dispatch limit allows (GL guarantees 65535
+  // work groups per axis).
+  constexpr std::size_t kMaxChunk = 65535;
+  const std::size_t chunk = std::min(slots.size(), kMaxChunk);
+  if (mBatch.size() < chunk * 4) mBatch = makeBuffer(std::max<std::uint64_t>(chunk * 4, 4096));
   const auto start = std::chrono::steady_clock::now();
   mTimer.begin();
-  if (params.sphere.z > 0.5f) {
-    mFoamProgram.use();
-    mFoamProgram.dispatch((params.brick.w + kFoamGroupSize - 1) / kFoamGroupSize, 1, 1);
+  for (std::size_t first = 0; first < slots.size(); first += kMaxChunk) {
+    const std::size_t count = std::min(kMaxChunk, slots.size() - first);
+    FoamClassifyParams p = params;
+    p.brick.w = std::uint32_t(count) * mLayout.subBricksPerSlot;
+    mFoamParams.upload(0, &p, sizeof(p));
+    mBatch.upload(0, slots.data() + first, count * 4);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT);
+    mFoamParams.bindBase(GL_UNIFORM_BUFFER, kParams);
+    mSubBricks.bindBase(GL_SHADER_STORAGE_BUFFER, kSubBricks);
+    mFoam.bindBase(GL_SHADER_STORAGE_BUFFER, kFoam);
+    mBatch.bindBase(GL_SHADER_STORAGE_BUFFER, kBatch);
+    mFoamOccupancy.bindBase(GL_SHADER_STORAGE_BUFFER, kFoamOccupancy);
+    if (params.sphere.z > 0.5f) {
+      mFoamProgram.use();
+      mFoamProgram.dispatch((mLayout.subBricksPerSlot + kFoamGroupSize - 1) / kFoamGroupSize, std::uint32_t(count), 1);
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    }
+    mOccupancyProgram.use();
+    mOccupancyProgram.dispatch((mLayout.foamOccupancyWords() + kFoamGroupSize - 1) / kFoamGroupSize,
+                               std::uint32_t(count), 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
   }
-  mOccupancyProgram.use();
-  const std::uint64_t words = std::uint64_t(slots.size()) * mLayout.foamOccupancyWords();
-  mOccupancyProgram.dispatch(std::uint32_t((words + kFoamGroupSize - 1) / kFoamGroupSize), 1, 1);
   mTimer.end();
-  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
   if (mSoftware) glFinish();
   mLastClassifyMs = mSoftware ? std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()
                               : mTimer.milliseconds();

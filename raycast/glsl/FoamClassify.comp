@@ -1,6 +1,7 @@
 // The foam classification pass (Reichl et al. 2014 §3.5): one invocation per sub-brick of a
-// batch of freshly uploaded bricks (raycast/glsl/FoamClassify.glsl). Bound by
-// raycast/GpuRaycaster.cpp: the pool's bits and foam bit-bricks, and the batch's slots.
+// batch of freshly uploaded bricks (raycast/glsl/FoamClassify.glsl); x: the sub-brick, y: the
+// brick of the batch. Bound by raycast/GpuRaycaster.cpp: the pool's bits and foam bit-bricks,
+// and the batch's slots.
 layout(local_size_x = 64) in;
 
 #include "BitBrick.glsl"
@@ -17,9 +18,8 @@ uvec4 fcFoam(uint slot, uint subBrick) { return foamBits[slot * FP.brick.z + sub
 #include "FoamClassify.glsl"
 
 void main() {
-  uint index = gl_GlobalInvocationID.x;
-  if (index >= FP.brick.w) return;
-  uint slot = batchSlots[index / FP.brick.z];
-  uint subBrick = index % FP.brick.z;
+  uint subBrick = gl_GlobalInvocationID.x;
+  if (subBrick >= FP.brick.z || gl_GlobalInvocationID.y >= FP.brick.w / FP.brick.z) return;
+  uint slot = batchSlots[gl_GlobalInvocationID.y];
   foamBits[slot * FP.brick.z + subBrick] = fcClassify(slot, subBrick);
 }

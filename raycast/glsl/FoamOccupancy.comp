@@ -1,5 +1,6 @@
 // The foam occupancy pass (raycast/glsl/FoamClassify.glsl, fcOccupancyWord): one invocation per
-// 32-bit word of the occupancy of a batch of freshly classified bricks. Bound by
+// 32-bit word of the occupancy of a batch of freshly classified bricks; x: the word, y: the
+// brick of the batch. Bound by
 // raycast/GpuRaycaster.cpp after FoamClassify.comp has finished.
 layout(local_size_x = 64) in;
 
@@ -19,9 +20,8 @@ uvec4 fcFoam(uint slot, uint subBrick) { return foamBits[slot * FP.brick.z + sub
 
 void main() {
   uint words = (FP.brick.z + 31u) / 32u;
-  uint index = gl_GlobalInvocationID.x;
-  if (index >= (FP.brick.w / FP.brick.z) * words) return;
-  uint slot = batchSlots[index / words];
-  uint word = index % words;
+  uint word = gl_GlobalInvocationID.x;
+  if (word >= words || gl_GlobalInvocationID.y >= FP.brick.w / FP.brick.z) return;
+  uint slot = batchSlots[gl_GlobalInvocationID.y];
   foamOccupancy[slot * words + word] = fcOccupancyWord(slot, word);
 }
