@@ -41,6 +41,12 @@ class Render : public ::testing::Test {
     ASSERT_EQ(convert.exitCode, 0) << convert.output;
   }
   std::string path(const std::string& name) const { return (dir / name).string(); }
+  /// Renders the store at 64x36 on the CPU with `options` into `name` and reads it back.
+  flipscope::ExrContents renderExr(const std::string& name, const std::string& options) {
+    CommandRun r = run("render " + path("store") + " -o " + path(name) + " --size 64x36 --device cpu " + options);
+    EXPECT_EQ(r.exitCode, 0) << options << "\n" << r.output;
+    return flipscope::readExr(path(name));
+  }
   flipscope::testing::TempDir temp{"render"};
   const fs::path& dir = temp.path();
 };
@@ -112,9 +118,7 @@ TEST_F(Render, AHoudiniFileRendersWithDefaults) {
 
 TEST_F(Render, SmoothingAndShadingOptionsChangeTheImage) {
   const auto render = [&](const std::string& name, const std::string& options) {
-    CommandRun r = run("render " + path("store") + " -o " + path(name) + " --size 64x36 --device cpu " + options);
-    EXPECT_EQ(r.exitCode, 0) << options << "\n" << r.output;
-    return flipscope::readExr(path(name)).image;
+    return renderExr(name, options).image;
   };
   const auto none = render("none.exr", "--smoothing none");
   const auto rof = render("rof.exr", "--smoothing rof --smoothing-strength 8");
@@ -133,14 +137,9 @@ TEST_F(Render, SmoothingAndShadingOptionsChangeTheImage) {
 
 TEST_F(Render, FoamOptionsChangeTheImageAndTheExrHasAFoamLayer) {
   // The synth fluid's splash holds isolated particles: a high threshold makes many cells foam.
-  const auto render = [&](const std::string& name, const std::string& options) {
-    CommandRun r = run("render " + path("store") + " -o " + path(name) + " --size 64x36 --device cpu " + options);
-    EXPECT_EQ(r.exitCode, 0) << options << "\n" << r.output;
-    return flipscope::readExr(path(name));
-  };
-  const auto volume = render("volume.exr", "--foam volume --foam-threshold 0.6");
-  const auto removed = render("remove.exr", "--foam remove --foam-threshold 0.6");
-  const auto kept = render("keep.exr", "--foam keep");
+  const auto volume = renderExr("volume.exr", "--foam volume --foam-threshold 0.6");
+  const auto removed = renderExr("remove.exr", "--foam remove --foam-threshold 0.6");
+  const auto kept = renderExr("keep.exr", "--foam keep");
   EXPECT_NE(std::find(volume.channels.begin(), volume.channels.end(), "foam.A"), volume.channels.end());
   EXPECT_EQ(std::find(kept.channels.begin(), kept.channels.end(), "foam.A"), kept.channels.end());
   double foam = 0, colourChange = 0;
