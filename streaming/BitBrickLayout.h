@@ -19,7 +19,9 @@ using glsl::bitBrickMipLevelCount;
 using glsl::bitBrickMipLevelWords;
 using glsl::bitBrickMipWordOffset;
 using glsl::bitBrickSubBrickDims;
+using glsl::bitBrickSubBrickCoord;
 using glsl::bitBrickSubBrickIndex;
+using glsl::bitBrickSubBrickLinear;
 
 /// Cells per sub-brick axis and bits per sub-brick.
 inline constexpr glm::uvec3 kSubBrickCells{4, 4, 8};

@@ -33,10 +33,9 @@ FS_FUNC uint fcNeighbourhoodSize(float radius) {
 FS_FUNC bool fcStoredCellSet(uint slot, ivec3 s) {
   int stored = int(FP.brick.x + 2u * FP.brick.y);
   if (s.x < 0 || s.y < 0 || s.z < 0 || s.x >= stored || s.y >= stored || s.z >= stored) return false;
-  uvec3 dims = bitBrickSubBrickDims(FP.brick.x, FP.brick.y);
-  uvec3 u = uvec3(s);
-  uint subBrick = (u.x >> 2u) + dims.x * ((u.y >> 2u) + dims.y * (u.z >> 3u));
-  return bitBrickBitSet(fcSubBrick(slot, subBrick), (u.x & 3u) + 4u * (u.y & 3u) + 16u * (u.z & 7u));
+  ivec3 cell = s - ivec3(int(FP.brick.y));
+  return bitBrickBitSet(fcSubBrick(slot, bitBrickSubBrickIndex(cell, FP.brick.x, FP.brick.y)),
+                        bitBrickBitIndex(cell, FP.brick.y));
 }
 
 // The foam bits of sub-brick `subBrick` of `slot`: the uploaded ones, plus (FP.sphere.z = 1) every
@@ -48,9 +47,8 @@ FS_FUNC uvec4 fcClassify(uint slot, uint subBrick) {
   float radius = FP.sphere.x;
   int reach = int(floor(radius));
   float needed = FP.sphere.y * float(fcNeighbourhoodSize(radius));
-  uvec3 dims = bitBrickSubBrickDims(FP.brick.x, FP.brick.y);
-  ivec3 origin = ivec3(int(subBrick % dims.x) * 4, int((subBrick / dims.x) % dims.y) * 4,
-                       int(subBrick / (dims.x * dims.y)) * 8);
+  ivec3 origin = ivec3(bitBrickSubBrickCoord(subBrick, bitBrickSubBrickDims(FP.brick.x, FP.brick.y)) *
+                       uvec3(4u, 4u, 8u));
   for (uint bit = 0u; bit < 128u; bit++) {
     if (!bitBrickBitSet(bits, bit)) continue;
     ivec3 s = origin + ivec3(int(bit & 3u), int((bit >> 2u) & 3u), int(bit >> 4u));
@@ -76,12 +74,12 @@ FS_FUNC uint fcOccupancyWord(uint slot, uint word) {
   for (uint i = 0u; i < 32u; i++) {
     uint subBrick = word * 32u + i;
     if (subBrick >= FP.brick.z) break;
-    ivec3 c = ivec3(int(subBrick % dims.x), int((subBrick / dims.x) % dims.y), int(subBrick / (dims.x * dims.y)));
+    ivec3 c = ivec3(bitBrickSubBrickCoord(subBrick, dims));
     bool foam = false;
     for (int d = 0; d < 27 && !foam; d++) {
       ivec3 q = c + ivec3(d % 3 - 1, (d / 3) % 3 - 1, d / 9 - 1);
       if (q.x < 0 || q.y < 0 || q.z < 0 || q.x >= int(dims.x) || q.y >= int(dims.y) || q.z >= int(dims.z)) continue;
-      uvec4 f = fcFoam(slot, uint(q.x) + dims.x * (uint(q.y) + dims.y * uint(q.z)));
+      uvec4 f = fcFoam(slot, bitBrickSubBrickLinear(uvec3(q), dims));
       foam = (f.x | f.y | f.z | f.w) != 0u;
     }
     if (foam) occupancy |= 1u << i;

@@ -81,8 +81,8 @@ FS_FUNC bool rcSurfaceCellSet(uint slot, ivec3 cell) {
 // halves of the sub-bricks; clamped to the stored blocks): x its sub-brick, y which half.
 FS_FUNC uvec2 rcHalfBlock(ivec3 block) {
   uvec3 dims = bitBrickSubBrickDims(P.grid.w, P.brick.x);
-  ivec3 b = clamp(block, ivec3(0), ivec3(int(dims.x) - 1, int(dims.y) - 1, int(2u * dims.z) - 1));
-  return uvec2(uint(b.x) + dims.x * (uint(b.y) + dims.y * (uint(b.z) >> 1u)), uint(b.z) & 1u);
+  uvec3 b = uvec3(clamp(block, ivec3(0), ivec3(int(dims.x) - 1, int(dims.y) - 1, int(2u * dims.z) - 1)));
+  return uvec2(bitBrickSubBrickLinear(uvec3(b.x, b.y, b.z >> 1u), dims), b.z & 1u);
 }
 
 // Density (0..1) of the sphere cells in the 4^3 block holding brick-local point `p` (§3.6).
@@ -117,15 +117,15 @@ FS_FUNC float rcFoamDensity(uint slot, vec3 p) {
 FS_FUNC float rcAccumulateFoam(float opacity, uint slot, vec3 o, vec3 dir, float a, float b) {
   float step = P.volume.x;
   float i = -floor(0.5f - a / step);  // the first i with t_i >= a
-  uvec3 dims = bitBrickSubBrickDims(P.grid.w, P.brick.x);
-  for (uint n = 0u; n < kRaycastMaxSteps && opacity < P.volume.z; n++) {
+  int n = int(P.brick.x);
+  for (uint k = 0u; k < kRaycastMaxSteps && opacity < P.volume.z; k++) {
     float t = (i + 0.5f) * step;
     if (t >= b) break;
     i += 1.0f;
     // Empty-space skipping: no foam within a sub-brick of the sample, no density.
     vec3 p = o + t * dir;
-    uvec3 s = uvec3(clamp(ivec3(floor(p)) + ivec3(int(P.brick.x)), ivec3(0), ivec3(int(P.grid.w + 2u * P.brick.x) - 1)));
-    uint subBrick = (s.x >> 2u) + dims.x * ((s.y >> 2u) + dims.y * (s.z >> 3u));
+    ivec3 cell = clamp(ivec3(floor(p)), ivec3(-n), ivec3(int(P.grid.w) + n - 1));
+    uint subBrick = bitBrickSubBrickIndex(cell, P.grid.w, P.brick.x);
     if (((rcFoamOccupancy(slot, subBrick >> 5u) >> (subBrick & 31u)) & 1u) == 0u) continue;
     float density = rcFoamDensity(slot, p);
     if (density > 0.0f) opacity += (1.0f - opacity) * (1.0f - exp(-P.volume.y * density * step));

@@ -28,11 +28,16 @@ FS_FUNC uvec3 bitBrickSubBrickDims(uint brickSize, uint overlap) {
   return uvec3((stored + 3u) / 4u, (stored + 3u) / 4u, (stored + 7u) / 8u);
 }
 
+// Index of the sub-brick at sub-brick coordinates `c` (each below `dims`), and back.
+FS_FUNC uint bitBrickSubBrickLinear(uvec3 c, uvec3 dims) { return c.x + dims.x * (c.y + dims.y * c.z); }
+FS_FUNC uvec3 bitBrickSubBrickCoord(uint index, uvec3 dims) {
+  return uvec3(index % dims.x, (index / dims.x) % dims.y, index / (dims.x * dims.y));
+}
+
 // Index into the brick's uvec4 array of the sub-brick holding brick-local `cell` in [-n, B+n).
 FS_FUNC uint bitBrickSubBrickIndex(ivec3 cell, uint brickSize, uint overlap) {
   uvec3 s = uvec3(cell + ivec3(int(overlap)));
-  uvec3 dims = bitBrickSubBrickDims(brickSize, overlap);
-  return (s.x >> 2u) + dims.x * ((s.y >> 2u) + dims.y * (s.z >> 3u));
+  return bitBrickSubBrickLinear(uvec3(s.x >> 2u, s.y >> 2u, s.z >> 3u), bitBrickSubBrickDims(brickSize, overlap));
 }
 
 // Bit index (0..127) of brick-local `cell` inside its sub-brick.
