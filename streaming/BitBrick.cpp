@@ -156,6 +156,7 @@ BrickCells makeBrickCells(const DecodedBrick& brick, const ConversionOptions& op
   std::uint64_t word = 0, wordIndex = 0;
   std::int64_t previous = -1;
   std::size_t keptCells = 0;
+  bool anyFoam = false;
   for (std::size_t i = 0; i < brick.cells.size(); ++i) {
     const std::uint32_t cell = brick.cells[i];
     FLIPSCOPE_CHECK(std::int64_t(cell) > previous, "cells not ascending: " << cell << " after " << previous);
@@ -168,9 +169,13 @@ BrickCells makeBrickCells(const DecodedBrick& brick, const ConversionOptions& op
       wordIndex = cell >> 6;
     }
     word |= std::uint64_t(1) << (cell & 63);
-    if (!out.foamKinds.empty() && foam(i)) out.foamKinds[cell >> 6] |= std::uint64_t(1) << (cell & 63);
+    if (!out.foamKinds.empty() && foam(i)) {
+      out.foamKinds[cell >> 6] |= std::uint64_t(1) << (cell & 63);
+      anyFoam = true;
+    }
   }
   out.bits[wordIndex] |= word;
+  if (!anyFoam) std::vector<std::uint64_t>().swap(out.foamKinds);  // no foam: nothing to assemble
   if (options.attribute == AttributeReduction::None) return out;
 
   out.wordRank.resize(out.bits.size());
@@ -281,11 +286,8 @@ BitBrick convertBrick(const Neighbourhood<BrickCells>& cells, const ConversionOp
 }
 
 std::vector<glm::uvec4> convertFoamKinds(const Neighbourhood<BrickCells>& cells, const ConversionOptions& options) {
-  bool any = false;
-  for (const BrickCells* c : cells)
-    if (c && !c->foamKinds.empty())
-      for (std::uint64_t w : c->foamKinds) any |= w != 0;
-  if (!any) return {};
+  if (std::none_of(cells.begin(), cells.end(), [](const BrickCells* c) { return c && !c->foamKinds.empty(); }))
+    return {};
   return assembleSubBricks(cells, options, &BrickCells::foamKinds);
 }
 

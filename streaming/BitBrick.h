@@ -74,8 +74,8 @@ struct BrickCells {
   std::vector<std::uint64_t> bits;            ///< bit x + B*(y + B*z); one padding word at the end
   std::vector<std::uint32_t> wordRank;        ///< set bits before each word (with attributes only)
   std::vector<std::uint16_t> cellAttributes;  ///< reduced value per occupied cell, in cell order
-  /// The cells of `bits` whose kind is Foam or Spray, in its layout; empty without (no kinds, or
-  /// ConversionOptions::foamKinds off).
+  /// The cells of `bits` whose kind is Foam or Spray, in its layout; empty when there is none (no
+  /// kinds, ConversionOptions::foamKinds off, or no such cell).
   std::vector<std::uint64_t> foamKinds;
 
   bool isSet(std::uint32_t linearCell) const { return (bits[linearCell >> 6] >> (linearCell & 63)) & 1u; }
