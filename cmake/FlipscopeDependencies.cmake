@@ -11,6 +11,10 @@ find_package(OpenEXR 3.1 REQUIRED)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash>=0.8)
 pkg_check_modules(EPOXY REQUIRED IMPORTED_TARGET epoxy>=1.5)
+# The viewer's window and panel: GLFW 3.3 and Dear ImGui 1.86 (its GLFW and OpenGL 3 backends
+# are in Debian's libimgui.a).
+find_package(glfw3 3.3 REQUIRED)
+pkg_check_modules(IMGUI REQUIRED IMPORTED_TARGET imgui>=1.86)
 # Blosc 1.21 (an OpenVDB dependency): our VDB reader decompresses with it (blosc_cbuffer_validate).
 pkg_check_modules(BLOSC REQUIRED IMPORTED_TARGET blosc>=1.21)
 

@@ -304,11 +304,20 @@ void EglContext::makeCurrent() const {
 
 std::string EglContext::renderer() const {
   if (mContext == EGL_NO_CONTEXT) return "(no context)";
+  return currentRenderer();
+}
+
+std::string currentRenderer() {
   const auto text = [](GLenum name) {
     const GLubyte* s = glGetString(name);
     return s ? std::string(reinterpret_cast<const char*>(s)) : std::string("?");
   };
   return text(GL_VENDOR) + " / " + text(GL_RENDERER) + " / " + text(GL_VERSION);
+}
+
+void requireCurrentGl45(const std::string& what) {
+  if (epoxy_gl_version() < 45)
+    throw Unavailable(what + ": the current context is OpenGL " + std::to_string(epoxy_gl_version()) + ", need 45");
 }
 
 }  // namespace flipscope::gl

@@ -55,6 +55,13 @@ class EglContext {
   std::string mPlatform;
 };
 
+/// "GL_VENDOR / GL_RENDERER / GL_VERSION" of the context current on this thread (any context:
+/// EGL, or a window's GLX); one must be current.
+std::string currentRenderer();
+/// Throws Unavailable naming `what` when the context current on this thread (one must be) is
+/// below OpenGL 4.5.
+void requireCurrentGl45(const std::string& what);
+
 /// Name of an EGL error code ("EGL_BAD_MATCH"), or its hex value when unknown.
 std::string eglErrorName(EGLint error);
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include <glm/trigonometric.hpp>
@@ -35,6 +36,18 @@ const ScreenPass kSphereNormal{"GBuffer.comp", "gbufferSphereNormal",
                                cpuScreenPass<glsl::GBufferKernel, &glsl::GBufferKernel::gbufferSphereNormal>};
 const ScreenPass kBlurThickness{"GBuffer.comp", "gbufferBlurThickness",
                                 cpuScreenPass<glsl::GBufferKernel, &glsl::GBufferKernel::gbufferBlurThickness>};
+}  // namespace
+
+namespace glsl {
+struct ProgressiveKernel : CpuScreenKernel {
+#include "pipeline/glsl/Progressive.glsl"
+};
+}  // namespace glsl
+
+namespace {
+const ScreenPass kProgressiveDisplay{
+    "Progressive.comp", "progressiveDisplay",
+    cpuScreenPass<glsl::ProgressiveKernel, &glsl::ProgressiveKernel::progressiveDisplay>};
 constexpr std::uint32_t kVec4PerHit = sizeof(RayHit) / sizeof(glm::vec4);
 }  // namespace
 
@@ -61,6 +74,8 @@ struct FramePipeline::Stages {
   ScreenImage smoothed = 0;
   ScreenImage normals = 0;
   ScreenImage shaded = 0;
+  ScreenImage display = 0;        ///< progressive: what the viewer shows
+  ScreenImage shown = 0;          ///< progressive: what it showed before
   std::unique_ptr<SurfaceFilter> filter;
   std::unique_ptr<SurfaceShading> shading;
   bool hitsOnDevice = false;      ///< the GPU's hit buffer is adopted, nothing is uploaded
@@ -76,9 +91,23 @@ float thicknessSaturationCells(const ShadingOptions& shading) {
   return weakest > 0 ? std::min(4.6051702f / weakest, float(kThicknessMaxCells)) : float(kThicknessMaxCells);
 }
 
-FramePipeline::FramePipeline(std::shared_ptr<BrickSource> source, DeviceChoice device, const RenderSettings& requested,
+FramePipeline::FramePipeline(std::shared_ptr<BrickSource> source, DeviceChoice device, const RenderSettings& settings,
                              const SurfaceSettings& surface, std::string* fallbackReason)
     : mSurface(surface) {
+  init(std::move(source), [&] { return createRaycastDevice(device, fallbackReason); }, settings);
+}
+
+FramePipeline::FramePipeline(std::shared_ptr<BrickSource> source, std::unique_ptr<RaycastDevice> raycaster,
+                             const RenderSettings& settings, const SurfaceSettings& surface)
+    : mSurface(surface) {
+  FLIPSCOPE_CHECK(raycaster, "FramePipeline without a ray-caster");
+  init(std::move(source), [&] { return std::move(raycaster); }, settings);
+}
+
+void FramePipeline::init(std::shared_ptr<BrickSource> source,
+                         const std::function<std::unique_ptr<RaycastDevice>()>& makeRaycaster,
+                         const RenderSettings& requested) {
+  const SurfaceSettings surface = mSurface;
   RenderSettings settings = requested;
   settings.thicknessSaturationCells = thicknessSaturationCells(surface.shading);
   validate(settings);
@@ -90,7 +119,7 @@ FramePipeline::FramePipeline(std::shared_ptr<BrickSource> source, DeviceChoice d
   if (surface.shading.colorRange && !(surface.shading.colorRange->x < surface.shading.colorRange->y))
     throw InputError("--color-range: A must be less than B");
   const EnvironmentMap map = surface.environment.empty() ? EnvironmentMap{} : loadEnvironmentMap(surface.environment);
-  auto raycaster = createRaycastDevice(device, fallbackReason);
+  auto raycaster = makeRaycaster();
   auto* gpu = dynamic_cast<GpuRaycaster*>(raycaster.get());
   const std::string name = raycaster->name();
   mRenderer = std::make_unique<FrameRenderer>(std::move(source), std::move(raycaster), settings);
@@ -115,6 +144,10 @@ FramePipeline::FramePipeline(std::shared_ptr<BrickSource> source, DeviceChoice d
   s.smoothed = mScreen->createFrameImage();
   s.normals = mScreen->createFrameImage();
   s.shaded = mScreen->createFrameImage();
+  s.display = mScreen->createFrameImage();
+  s.shown = mScreen->createFrameImage();
+  mScreen->clear(s.display);
+  mScreen->clear(s.shown);
   s.filter = createSurfaceFilter(mSurface.smoothing);
   s.shading = std::make_unique<SurfaceShading>(*mScreen, mSurface.shading, map);
 }
@@ -141,15 +174,53 @@ ScreenFrame FramePipeline::screenFrame(const Camera& camera) const {
 
 FrameOutput FramePipeline::render(int frame, const Camera& camera, int direction) {
   const auto start = Clock::now();
-  FrameOutput out;
-  out.frame = frame;
+  mFrame = frame;
+  mCamera = camera;
+  StageTimes stages;
+  const RenderStats stats = mRenderer->trace(frame, camera, direction);
+  stages.trace = msSince(start);
+  shade(frame, camera, stages);
+  const auto readStart = Clock::now();
+  FrameOutput out = readOutput();
+  stages.readback = msSince(readStart);
+  out.stats = stats;
+  out.stages = stages;
+  out.stages.total = msSince(start);
+  return out;
+}
+
+void FramePipeline::begin(int frame, const Camera& camera, int direction) {
+  mRenderer->begin(frame, camera, direction);
+  mFrame = frame;
+  mCamera = camera;
+}
+
+FramePipeline::Progress FramePipeline::advance(double budgetMs) {
+  const auto start = Clock::now();
+  Progress progress;
+  progress.stats = mRenderer->advance(budgetMs, &progress.changed);
+  progress.stages.trace = msSince(start);
+  if (progress.changed) {
+    shade(mFrame, mCamera, progress.stages);
+    Stages& s = *mStages;
+    mScreen->run(kProgressiveDisplay, nullptr, 0, {s.hits, s.shaded, s.shown}, s.display);
+    mScreen->copy(s.display, s.shown);
+    mScreen->finish();
+  }
+  progress.stages.total = msSince(start);
+  return progress;
+}
+
+std::vector<glm::vec4> FramePipeline::downloadDisplay() { return mScreen->download(mStages->display); }
+
+const gl::Buffer* FramePipeline::displayBuffer() const {
+  auto* gpu = dynamic_cast<GpuScreenDevice*>(mScreen.get());
+  return gpu ? &gpu->buffer(mStages->display) : nullptr;
+}
+
+void FramePipeline::shade(int frame, const Camera& camera, StageTimes& stages) {
   Stages& s = *mStages;
   ScreenDevice& device = *mScreen;
-
-  auto stage = Clock::now();
-  out.stats = mRenderer->trace(frame, camera, direction);
-  out.stages.trace = msSince(stage);
-
   auto timed = [&](double& ms, auto&& work) {
     const auto begin = Clock::now();
     work();
@@ -157,7 +228,7 @@ FrameOutput FramePipeline::render(int frame, const Camera& camera, int direction
     ms = msSince(begin);
   };
   device.setFrame(screenFrame(camera));
-  timed(out.stages.gbuffer, [&] {
+  timed(stages.gbuffer, [&] {
     if (!s.hitsOnDevice) {
       const auto& hits = static_cast<const CpuRaycaster&>(mRenderer->device()).hits();
       device.upload(s.hits, std::span<const glm::vec4>(reinterpret_cast<const glm::vec4*>(hits.data()),
@@ -167,49 +238,55 @@ FrameOutput FramePipeline::render(int frame, const Camera& camera, int direction
     device.run(kBlurThickness, nullptr, 0, {s.rawGbuffer}, s.gbuffer);
     device.run(kSphereNormal, nullptr, 0, {s.hits}, s.sphereNormals);
   });
-  timed(out.stages.smoothing, [&] { s.filter->apply(device, s.gbuffer, s.smoothed); });
-  timed(out.stages.normals, [&] { reconstructNormals(device, s.smoothed, s.normals); });
+  timed(stages.smoothing, [&] { s.filter->apply(device, s.gbuffer, s.smoothed); });
+  timed(stages.normals, [&] { reconstructNormals(device, s.smoothed, s.normals); });
   // The attribute values of the G-buffer's 0 and 1: the frame's quantization range.
   const StoreHeader& header = mRenderer->source().header();
-  const bool attribute = header.attribute != AttributeKind::None;
-  const FrameStats stats = attribute ? mRenderer->source().frame(frame)->stats : FrameStats{};
+  const FrameStats stats =
+      header.attribute != AttributeKind::None ? mRenderer->source().frame(frame)->stats : FrameStats{};
   s.shading->setFrameAttributeRange(stats.attributeMin, stats.attributeMax);
-  timed(out.stages.shading, [&] { s.shading->shade(device, s.gbuffer, s.normals, s.sphereNormals, s.shaded); });
+  timed(stages.shading, [&] { s.shading->shade(device, s.gbuffer, s.normals, s.sphereNormals, s.shaded); });
+}
 
-  timed(out.stages.readback, [&] {
-    RenderImage& image = out.image;
-    image.width = device.width();
-    image.height = device.height();
-    image.rgba = device.download(s.shaded);
-    const auto gbuffer = device.download(s.gbuffer);
-    const auto smoothed = device.download(s.smoothed);
-    const auto normals = device.download(s.normals);
-    const std::size_t n = gbuffer.size();
-    constexpr float kInf = std::numeric_limits<float>::infinity();
-    image.depth.resize(n);
-    image.unsmoothedDepth.resize(n);
-    image.thickness.resize(n);
-    image.normal.resize(n);
-    if (mSurface.shading.foam) {
-      const auto hitExtras = device.download(s.sphereNormals);
-      image.foam.resize(n);
-      for (std::size_t i = 0; i < n; ++i) image.foam[i] = glm::vec4(mSurface.shading.foamColour * hitExtras[i].w, hitExtras[i].w);
-    }
-    if (attribute) {
-      image.attribute.resize(n);
-      image.attributeName = header.attributeName;
-    }
-    const float span = stats.attributeMax - stats.attributeMin;
-    for (std::size_t i = 0; i < n; ++i) {
-      const bool hit = gbuffer[i].y > 0.5f;
-      image.depth[i] = hit ? smoothed[i].x : kInf;
-      image.unsmoothedDepth[i] = hit ? gbuffer[i].x : kInf;
-      image.thickness[i] = hit ? gbuffer[i].z : 0.0f;
-      image.normal[i] = hit ? glm::vec3(normals[i]) : glm::vec3(0);
-      if (attribute) image.attribute[i] = hit ? stats.attributeMin + gbuffer[i].w * span : 0.0f;
-    }
-  });
-  out.stages.total = msSince(start);
+FrameOutput FramePipeline::readOutput() {
+  Stages& s = *mStages;
+  ScreenDevice& device = *mScreen;
+  FrameOutput out;
+  out.frame = mFrame;
+  const StoreHeader& header = mRenderer->source().header();
+  const bool attribute = header.attribute != AttributeKind::None;
+  const FrameStats stats = attribute ? mRenderer->source().frame(mFrame)->stats : FrameStats{};
+  RenderImage& image = out.image;
+  image.width = device.width();
+  image.height = device.height();
+  image.rgba = device.download(s.shaded);
+  const auto gbuffer = device.download(s.gbuffer);
+  const auto smoothed = device.download(s.smoothed);
+  const auto normals = device.download(s.normals);
+  const std::size_t n = gbuffer.size();
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  image.depth.resize(n);
+  image.unsmoothedDepth.resize(n);
+  image.thickness.resize(n);
+  image.normal.resize(n);
+  if (mSurface.shading.foam) {
+    const auto hitExtras = device.download(s.sphereNormals);
+    image.foam.resize(n);
+    for (std::size_t i = 0; i < n; ++i) image.foam[i] = glm::vec4(mSurface.shading.foamColour * hitExtras[i].w, hitExtras[i].w);
+  }
+  if (attribute) {
+    image.attribute.resize(n);
+    image.attributeName = header.attributeName;
+  }
+  const float span = stats.attributeMax - stats.attributeMin;
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool hit = gbuffer[i].y > 0.5f;
+    image.depth[i] = hit ? smoothed[i].x : kInf;
+    image.unsmoothedDepth[i] = hit ? gbuffer[i].x : kInf;
+    image.thickness[i] = hit ? gbuffer[i].z : 0.0f;
+    image.normal[i] = hit ? glm::vec3(normals[i]) : glm::vec3(0);
+    if (attribute) image.attribute[i] = hit ? stats.attributeMin + gbuffer[i].w * span : 0.0f;
+  }
   return out;
 }
 

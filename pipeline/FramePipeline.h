@@ -17,6 +17,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -70,6 +71,10 @@ class FramePipeline {
   /// `device` is Gpu and there is none. `fallbackReason` says why Auto chose the CPU.
   FramePipeline(std::shared_ptr<BrickSource> source, DeviceChoice device, const RenderSettings& settings,
                 const SurfaceSettings& surface, std::string* fallbackReason = nullptr);
+  /// The same on a ray-caster made by the caller (the viewer's GpuRaycaster in its window's
+  /// context, which must be current while the pipeline is used and destroyed).
+  FramePipeline(std::shared_ptr<BrickSource> source, std::unique_ptr<RaycastDevice> raycaster,
+                const RenderSettings& settings, const SurfaceSettings& surface);
   /// The same over a store (through a StoreBrickSource).
   FramePipeline(BrickStore store, DeviceChoice device, const RenderSettings& settings,
                 const SurfaceSettings& surface, std::string* fallbackReason = nullptr);
@@ -77,7 +82,30 @@ class FramePipeline {
   FramePipeline(const FramePipeline&) = delete;
   FramePipeline& operator=(const FramePipeline&) = delete;
 
+  /// The frame converged (or stopped at the pass limit), shaded and read back.
   FrameOutput render(int frame, const Camera& camera, int direction = 0);
+
+  /// Progressive rendering for the viewer. begin() starts `frame` from `camera`; each advance()
+  /// runs ray-caster passes for about `budgetMs` without waiting for brick conversion
+  /// (FrameRenderer::advance), then, when any ray changed, the screen stages over the rays so
+  /// far and the display image: the shaded frame where rays have finished, the image shown
+  /// before where they are still pending (pipeline/glsl/Progressive.glsl). Once finished() the
+  /// display is the image render() gives.
+  struct Progress {
+    bool changed = false;  ///< the display image was redrawn in this call
+    RenderStats stats;     ///< the frame's so far
+    StageTimes stages;     ///< of this call: trace and, when changed, the screen stages
+  };
+  void begin(int frame, const Camera& camera, int direction = 0);
+  Progress advance(double budgetMs);
+  bool finished() const { return mRenderer->finished(); }
+  /// The images of the last shaded frame (begin()'s frame), as render() returns them.
+  FrameOutput readOutput();
+  /// The display image, rgba per pixel, row 0 at the top (zeros before the first advance()).
+  std::vector<glm::vec4> downloadDisplay();
+  /// The display image's shader storage buffer (vec4 per pixel) in the pipeline's OpenGL
+  /// context; nullptr when the pipeline runs on the CPU.
+  const gl::Buffer* displayBuffer() const;
 
   FrameRenderer& renderer() { return *mRenderer; }
   const FrameRenderer& renderer() const { return *mRenderer; }
@@ -88,10 +116,16 @@ class FramePipeline {
 
  private:
   struct Stages;
+  void init(std::shared_ptr<BrickSource> source, const std::function<std::unique_ptr<RaycastDevice>()>& makeRaycaster,
+            const RenderSettings& settings);
+  /// The screen stages over the ray-caster's current hits, into the stages' images.
+  void shade(int frame, const Camera& camera, StageTimes& stages);
   std::unique_ptr<FrameRenderer> mRenderer;
   std::unique_ptr<ScreenDevice> mScreen;  // destroyed before the renderer's GL context
   std::unique_ptr<Stages> mStages;
   SurfaceSettings mSurface;
+  int mFrame = 0;          ///< of the last begin() or render()
+  Camera mCamera;
 };
 
 /// Liquid cells at which the thickness trace behind a hit stops (§3.6): where the channel that

@@ -175,103 +175,174 @@ RenderResult FrameRenderer::render(int frame, const Camera& camera, int directio
   return result;
 }
 
+/// The frame begun by begin(): its index, pass parameters, page table and statistics so far.
+struct FrameRenderer::ActiveFrame {
+  int frame = 0;
+  std::shared_ptr<const FrameIndex> index;
+  RaycastParams params{};
+  std::vector<std::uint32_t> pages;
+  glm::dvec3 eyeInBricks{0};
+  RenderStats stats;
+  std::uint64_t failedBefore = 0;  ///< Streamer failures before this frame
+  bool traceDue = true;            ///< a brick arrived since the last pass (or none ran yet)
+  bool finished = false;
+};
+
 RenderStats FrameRenderer::trace(int frame, const Camera& camera, int direction) {
   const auto start = Clock::now();
+  begin(frame, camera, direction);
+  runPasses(true, std::numeric_limits<double>::infinity(), nullptr);
+  mActive->stats.totalMs = msSince(start);
+  return mActive->stats;
+}
+
+void FrameRenderer::begin(int frame, const Camera& camera, int direction) {
   validate(camera, "camera");
   if (!mSource->hasFrame(frame)) throw InputError(mSource->name() + ": no frame " + std::to_string(frame));
-  const auto index = mSource->frame(frame);
+  auto active = std::make_unique<ActiveFrame>();
+  ActiveFrame& a = *active;
+  a.frame = frame;
+  a.index = mSource->frame(frame);
   const StoreHeader& header = mSource->header();
-
-  RenderStats stats;
-  stats.frameBricks = index->bricks.size();
-  stats.poolBytes = mPool.layout().bytes();
-
-  const glm::dvec3 eyeInBricks = (camera.eye - header.origin) / (header.cellSize * header.brickSize);
+  a.stats.frameBricks = a.index->bricks.size();
+  a.stats.poolBytes = mPool.layout().bytes();
+  a.eyeInBricks = (camera.eye - header.origin) / (header.cellSize * header.brickSize);
   mStreamer->setFrame(frame, direction);
-  mStreamer->setEye(eyeInBricks);
-  std::vector<std::uint32_t> pages = pageTable(*index);
-  mDevice->setOctree(index->octree.nodes);
-  mDevice->setPageTable(pages);
+  mStreamer->setEye(a.eyeInBricks);
+  a.failedBefore = mStreamer->stats().failed;
+  a.pages = pageTable(*a.index);
+  mDevice->setOctree(a.index->octree.nodes);
+  mDevice->setPageTable(a.pages);
   mDevice->beginImage(mSettings.width, mSettings.height);
-  RaycastParams params = this->params(camera, *index);
+  a.params = params(camera, *a.index);
+  a.stats.bricksResident = mPool.resident();
+  mActive = std::move(active);
+}
 
-  std::vector<BrickKey> evicted;
-  for (stats.passes = 1;; ++stats.passes) {
-    const std::vector<std::uint32_t> requests = mDevice->trace(params);
-    stats.traceMs += mDevice->lastTraceMs();
-    if (requests.empty()) {
-      stats.converged = true;
-      break;
-    }
-    if (stats.passes == mSettings.maxPasses) break;
-    stats.bricksRequested += requests.size();
+const RenderStats& FrameRenderer::advance(double budgetMs, bool* changed) {
+  FLIPSCOPE_CHECK(mActive, "FrameRenderer::advance() before begin()");
+  const auto start = Clock::now();
+  runPasses(false, budgetMs, changed);
+  mActive->stats.totalMs += msSince(start);
+  return mActive->stats;
+}
 
-    // Convert (or fetch from the CPU cache) every requested brick.
-    auto streamStart = Clock::now();
-    std::vector<glm::uvec3> coords;
-    std::unordered_map<BrickKey, std::uint32_t, BrickKeyHash> wanted;  // key -> brick index
-    for (std::uint32_t i : requests) {
-      FLIPSCOPE_CHECK(i < index->bricks.size(), "request for brick " << i);
-      coords.push_back(index->bricks[i].coord);
-      wanted.emplace(BrickKey{frame, index->bricks[i].coord}, i);
-    }
-    const std::uint64_t failedBefore = mStreamer->stats().failed;
-    mStreamer->request(coords);
-    std::vector<std::shared_ptr<const ConvertedBrick>> bricks;
-    while (bricks.size() < wanted.size()) {
-      mStreamer->waitIdle();
-      auto ready = mStreamer->takeReady(wanted.size());
-      if (mStreamer->stats().failed > failedBefore) mStreamer->rethrowLastError();
-      if (ready.empty())
-        throw LogicError("the streamer delivered " + std::to_string(bricks.size()) + " of " +
-                         std::to_string(wanted.size()) + " requested bricks");
-      for (auto& brick : ready)
-        if (wanted.contains(brick->key)) bricks.push_back(std::move(brick));
-    }
-    stats.streamMs += msSince(streamStart);
+bool FrameRenderer::finished() const { return mActive && mActive->finished; }
 
-    // Upload nearest first: when the pool is too small for all, the front of the image goes first.
-    auto uploadStart = Clock::now();
-    auto distance = [&](const ConvertedBrick& b) {
-      const glm::dvec3 d = glm::dvec3(b.key.coord) + 0.5 - eyeInBricks;
-      return glm::dot(d, d);
-    };
-    std::sort(bricks.begin(), bricks.end(), [&](const auto& a, const auto& b) {
-      const double da = distance(*a), db = distance(*b);
-      return da != db ? da < db : wanted.at(a->key) < wanted.at(b->key);
-    });
-    const std::uint64_t batch = ++mBatch;
-    std::vector<std::uint32_t> uploadedSlots;
-    for (const auto& brick : bricks) {
-      evicted.clear();
-      const auto placement = mPool.place(brick->key, brick->bits.attributes.size(), batch, evicted);
-      for (const BrickKey& key : evicted) {
-        ++stats.bricksEvicted;
-        if (key.frame != frame) continue;
-        pages[std::size_t(index->octree.find(key.coord))] = kNotResident;
-        // The pool cannot hold what this frame needs at once: thickness behind a hit becomes
-        // best effort, so the bricks of hits and of thickness marches cannot evict each other
-        // forever. Hits stay exact.
-        params.sphere.z = 1.0f;
+void FrameRenderer::runPasses(bool wait, double budgetMs, bool* changed) {
+  ActiveFrame& a = *mActive;
+  RenderStats& stats = a.stats;
+  const auto start = Clock::now();
+  if (changed) *changed = false;
+  while (!a.finished) {
+    if (a.traceDue) {
+      a.traceDue = false;
+      ++stats.passes;
+      if (changed) *changed = true;
+      const std::vector<std::uint32_t> requests = mDevice->trace(a.params);
+      stats.traceMs += mDevice->lastTraceMs();
+      if (requests.empty()) {
+        stats.converged = true;
+        a.finished = true;
+        break;
       }
-      if (!placement) break;  // the pool holds this pass's bricks only: the rest next pass
-      mDevice->uploadBrick(placement->slot, placement->attributeOffset, *brick);
-      pages[wanted.at(brick->key)] = placement->slot;
-      uploadedSlots.push_back(placement->slot);
-      ++stats.bricksUploaded;
+      if (stats.passes >= mSettings.maxPasses) {
+        a.finished = true;
+        break;
+      }
+      stats.bricksRequested += requests.size();
+      std::vector<glm::uvec3> coords;
+      coords.reserve(requests.size());
+      for (std::uint32_t i : requests) {
+        FLIPSCOPE_CHECK(i < a.index->bricks.size(), "request for brick " << i);
+        coords.push_back(a.index->bricks[i].coord);
+      }
+      mStreamer->request(coords);
+      if (wait) {
+        // Convert (or fetch from the CPU cache) every requested brick before the next pass.
+        const auto streamStart = Clock::now();
+        std::unordered_map<BrickKey, bool, BrickKeyHash> wanted;
+        for (glm::uvec3 coord : coords) wanted.emplace(BrickKey{a.frame, coord}, false);
+        std::vector<std::shared_ptr<const ConvertedBrick>> bricks;
+        while (bricks.size() < wanted.size()) {
+          mStreamer->waitIdle();
+          auto ready = mStreamer->takeReady(wanted.size());
+          if (mStreamer->stats().failed > a.failedBefore) mStreamer->rethrowLastError();
+          if (ready.empty())
+            throw LogicError("the streamer delivered " + std::to_string(bricks.size()) + " of " +
+                             std::to_string(wanted.size()) + " requested bricks");
+          for (auto& brick : ready)
+            if (wanted.contains(brick->key)) bricks.push_back(std::move(brick));
+        }
+        stats.streamMs += msSince(streamStart);
+        upload(std::move(bricks));
+        a.traceDue = true;
+        continue;
+      }
     }
-    mDevice->setPageTable(pages);
-    stats.uploadMs += msSince(uploadStart);
-    // §3.5: the bricks uploaded in this pass are classified in one batch before the next trace.
-    if (mSettings.foam.mode != FoamMode::Keep && !uploadedSlots.empty()) {
-      mDevice->classifyFoam(uploadedSlots, foamParams(uploadedSlots.size()));
-      stats.foamMs += mDevice->lastClassifyMs();
-      stats.bricksClassified += uploadedSlots.size();
+    // Progressive: take whatever the Streamer has finished, never wait for the rest.
+    const auto streamStart = Clock::now();
+    auto ready = mStreamer->takeReady(std::max<std::size_t>(a.index->bricks.size(), 1));
+    if (mStreamer->stats().failed > a.failedBefore) mStreamer->rethrowLastError();
+    std::erase_if(ready, [&](const auto& brick) {
+      if (brick->key.frame != a.frame) return true;
+      const std::int64_t i = a.index->octree.find(brick->key.coord);
+      return i < 0 || a.pages[std::size_t(i)] != kNotResident;
+    });
+    stats.streamMs += msSince(streamStart);
+    // A brick the pool could not place this time is requested again by the next pass.
+    if (!ready.empty()) {
+      upload(std::move(ready));
+      a.traceDue = true;
     }
+    if (!a.traceDue || msSince(start) >= budgetMs) break;
   }
   stats.bricksResident = mPool.resident();
-  stats.totalMs = msSince(start);
-  return stats;
+}
+
+void FrameRenderer::upload(std::vector<std::shared_ptr<const ConvertedBrick>> bricks) {
+  ActiveFrame& a = *mActive;
+  RenderStats& stats = a.stats;
+  // Upload nearest first: when the pool is too small for all, the front of the image goes first.
+  const auto uploadStart = Clock::now();
+  auto brickIndex = [&](const ConvertedBrick& b) { return a.index->octree.find(b.key.coord); };
+  auto distance = [&](const ConvertedBrick& b) {
+    const glm::dvec3 d = glm::dvec3(b.key.coord) + 0.5 - a.eyeInBricks;
+    return glm::dot(d, d);
+  };
+  std::sort(bricks.begin(), bricks.end(), [&](const auto& x, const auto& y) {
+    const double dx = distance(*x), dy = distance(*y);
+    return dx != dy ? dx < dy : brickIndex(*x) < brickIndex(*y);
+  });
+  const std::uint64_t batch = ++mBatch;
+  std::vector<std::uint32_t> uploadedSlots;
+  std::vector<BrickKey> evicted;
+  for (const auto& brick : bricks) {
+    evicted.clear();
+    const auto placement = mPool.place(brick->key, brick->bits.attributes.size(), batch, evicted);
+    for (const BrickKey& key : evicted) {
+      ++stats.bricksEvicted;
+      if (key.frame != a.frame) continue;
+      a.pages[std::size_t(a.index->octree.find(key.coord))] = kNotResident;
+      // The pool cannot hold what this frame needs at once: thickness behind a hit becomes
+      // best effort, so the bricks of hits and of thickness marches cannot evict each other
+      // forever. Hits stay exact.
+      a.params.sphere.z = 1.0f;
+    }
+    if (!placement) break;  // the pool holds this pass's bricks only: the rest next pass
+    mDevice->uploadBrick(placement->slot, placement->attributeOffset, *brick);
+    a.pages[std::size_t(brickIndex(*brick))] = placement->slot;
+    uploadedSlots.push_back(placement->slot);
+    ++stats.bricksUploaded;
+  }
+  mDevice->setPageTable(a.pages);
+  stats.uploadMs += msSince(uploadStart);
+  // §3.5: the bricks uploaded in this pass are classified in one batch before the next trace.
+  if (mSettings.foam.mode != FoamMode::Keep && !uploadedSlots.empty()) {
+    mDevice->classifyFoam(uploadedSlots, foamParams(uploadedSlots.size()));
+    stats.foamMs += mDevice->lastClassifyMs();
+    stats.bricksClassified += uploadedSlots.size();
+  }
 }
 
 }  // namespace flipscope

@@ -100,8 +100,22 @@ class FrameRenderer {
   /// read-ahead.
   RenderResult render(int frame, const Camera& camera, int direction = 0);
   /// render() without reading the hits back: they stay on the device for the screen-space
-  /// stages (pipeline/FramePipeline.h).
+  /// stages (pipeline/FramePipeline.h). begin(), then passes that wait for the Streamer until
+  /// the frame converges or the pass limit is reached.
   RenderStats trace(int frame, const Camera& camera, int direction = 0);
+
+  /// Progressive rendering for the viewer (§3.3: "this rendering can only be performed in the
+  /// next frame"). begin() starts `frame` with every ray fresh and traces nothing; each
+  /// advance() then runs passes for about `budgetMs` and returns without waiting for the
+  /// Streamer: bricks still converting stay requested, their rays pending, and the pass after
+  /// they arrive resumes them. A pass runs only when a brick was uploaded since the last one (or
+  /// at the start), so a slice that finds nothing new costs no trace. The same errors as
+  /// trace(); advance() without begin() is a LogicError.
+  void begin(int frame, const Camera& camera, int direction = 0);
+  /// The begun frame's statistics so far; `changed` says whether any pass ran in this call.
+  const RenderStats& advance(double budgetMs, bool* changed = nullptr);
+  /// Converged, or stopped at the pass limit.
+  bool finished() const;
 
   BrickSource& source() const { return *mSource; }
   RaycastDevice& device() { return *mDevice; }
@@ -118,7 +132,14 @@ class FrameRenderer {
   FoamClassifyParams foamParams(std::size_t slots) const;
 
  private:
+  struct ActiveFrame;
   std::vector<std::uint32_t> pageTable(const FrameIndex& frame) const;
+  /// Runs passes of the active frame: waiting for every requested brick (trace()), or until
+  /// `budgetMs` has passed or nothing new is ready (advance()).
+  void runPasses(bool wait, double budgetMs, bool* changed);
+  /// Places and uploads `bricks` of the active frame nearest to the eye first, then classifies
+  /// their foam.
+  void upload(std::vector<std::shared_ptr<const ConvertedBrick>> bricks);
 
   std::shared_ptr<BrickSource> mSource;
   std::unique_ptr<RaycastDevice> mDevice;
@@ -128,6 +149,7 @@ class FrameRenderer {
   BrickPool mPool;
   std::unique_ptr<Streamer> mStreamer;
   std::uint64_t mBatch = 0;
+  std::unique_ptr<ActiveFrame> mActive;
 };
 
 }  // namespace flipscope

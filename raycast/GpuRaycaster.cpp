@@ -43,13 +43,19 @@ gl::Buffer makeBuffer(std::uint64_t bytes, const void* data = nullptr) {
 }
 }  // namespace
 
-GpuRaycaster::GpuRaycaster()
-    : mContext(gl::EglContext::create()), mProgram(gl::Program::compute(gl::shaderSource("Raycast.comp"))) {
+GpuRaycaster::GpuRaycaster() : GpuRaycaster(gl::EglContext::create()) {}
+
+GpuRaycaster::GpuRaycaster(AdoptCurrentContext) : GpuRaycaster(gl::EglContext{}) {}
+
+GpuRaycaster::GpuRaycaster(gl::EglContext context) : mContext(std::move(context)) {
+  mPlatform = mContext.isValid() ? mContext.platform() : "window";
+  if (!mContext.isValid()) gl::requireCurrentGl45("GpuRaycaster");
+  mProgram = gl::Program::compute(gl::shaderSource("Raycast.comp"));
   GLint64 maxBlock = 0;
   glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxBlock);
   mMaxBufferBytes = std::uint64_t(maxBlock);
   // llvmpipe answers timer queries with ~0: time its passes on the wall clock instead.
-  const std::string renderer = mContext.renderer();
+  const std::string renderer = gl::currentRenderer();
   mSoftware = renderer.find("llvmpipe") != std::string::npos || renderer.find("softpipe") != std::string::npos;
   mParams = makeBuffer(sizeof(RaycastParams));
   mFoam = makeBuffer(0);  // bound by every trace; a pool without foam never reads them
@@ -58,7 +64,7 @@ GpuRaycaster::GpuRaycaster()
 
 GpuRaycaster::~GpuRaycaster() = default;
 
-std::string GpuRaycaster::name() const { return "OpenGL (" + mContext.platform() + "): " + mContext.renderer(); }
+std::string GpuRaycaster::name() const { return "OpenGL (" + mPlatform + "): " + gl::currentRenderer(); }
 
 void GpuRaycaster::allocatePool(const PoolLayout& layout) {
   mLayout = layout;

@@ -13,9 +13,15 @@ namespace flipscope {
 
 class GpuRaycaster : public RaycastDevice {
  public:
-  /// Creates the context and compiles the shader. Throws gl::Unavailable without a usable
-  /// EGL/OpenGL 4.5 device.
+  /// Creates a headless EGL context and compiles the shader. Throws gl::Unavailable without a
+  /// usable EGL/OpenGL 4.5 device.
   GpuRaycaster();
+  /// Tag: run in the context the caller made current (a window's), which it keeps alive and
+  /// current while the ray-caster is used and destroyed.
+  struct AdoptCurrentContext {};
+  /// Adopts the OpenGL 4.5 context current on this thread and compiles the shader there. Throws
+  /// gl::Unavailable when that context is below OpenGL 4.5.
+  explicit GpuRaycaster(AdoptCurrentContext);
   ~GpuRaycaster() override;
 
   std::string name() const override;
@@ -38,7 +44,10 @@ class GpuRaycaster : public RaycastDevice {
   const gl::Buffer& hitBuffer() const { return mHits; }
 
  private:
-  gl::EglContext mContext;
+  explicit GpuRaycaster(gl::EglContext context);
+
+  gl::EglContext mContext;  ///< empty when the context is adopted
+  std::string mPlatform;    ///< "device", "surfaceless", "default", or "window" when adopted
   gl::Program mProgram;
   gl::Program mFoamProgram;       ///< raycast/glsl/FoamClassify.comp, compiled on first use
   gl::Program mOccupancyProgram;  ///< raycast/glsl/FoamOccupancy.comp, likewise

@@ -64,6 +64,11 @@ GpuScreenDevice::Image& GpuScreenDevice::image(ScreenImage handle) {
   return mImages[handle];
 }
 
+const gl::Buffer& GpuScreenDevice::buffer(ScreenImage handle) const {
+  FLIPSCOPE_CHECK(handle < mImages.size(), "screen image " << handle);
+  return mImages[handle].buffer();
+}
+
 void GpuScreenDevice::upload(ScreenImage handle, std::span<const glm::vec4> data) {
   Image& target = image(handle);
   FLIPSCOPE_CHECK(!target.adopted && data.size() == target.elements, data.size() << " != " << target.elements);

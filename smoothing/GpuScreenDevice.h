@@ -34,6 +34,8 @@ class GpuScreenDevice : public ScreenDevice {
   void run(const ScreenPass& pass, const void* params, std::size_t paramBytes,
            std::initializer_list<ScreenImage> inputs, ScreenImage output) override;
   void finish() override;
+  /// The shader storage buffer behind `image` (the viewer copies its display image from it).
+  const gl::Buffer& buffer(ScreenImage image) const;
 
  private:
   struct Image {

@@ -86,6 +86,8 @@ class StoreBrickSource : public BrickSource {
   std::string name() const override { return mStore.directory().string(); }
 
   const BrickStore& store() const { return mStore; }
+  /// BrickStore::reloadFrameTable: frames a concurrent convert listed since. Thread safe.
+  bool reloadFrames() { return mStore.reloadFrameTable(); }
 
  private:
   BrickStore mStore;

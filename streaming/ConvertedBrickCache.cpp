@@ -1,6 +1,8 @@
 // CPU brick cache (Reichl et al. 2014 §4.1) with optional in-memory zstd compression.
 #include "streaming/ConvertedBrickCache.h"
 
+#include <set>
+
 #include <cstring>
 
 #include <zstd.h>
@@ -98,6 +100,12 @@ void ConvertedBrickCache::insert(std::shared_ptr<const ConvertedBrick> brick) {
     entry->brick = std::move(brick);
   }
   mEntries.insert(key, std::move(entry), bytes + sizeof(Entry));
+}
+
+std::vector<int> ConvertedBrickCache::frames() const {
+  std::set<int> frames;
+  mEntries.forEachKey([&](const BrickKey& key) { frames.insert(key.frame); });
+  return {frames.begin(), frames.end()};
 }
 
 }  // namespace flipscope

@@ -39,6 +39,8 @@ class ConvertedBrickCache {
   bool contains(const BrickKey& key) const { return mEntries.contains(key); }
   bool isCompressing() const { return mCompress; }
   std::size_t bytes() const { return mEntries.bytes(); }
+  /// The frames of which the cache holds at least one brick, ascending. Thread safe.
+  std::vector<int> frames() const;
   std::size_t budget() const { return mEntries.budget(); }
   CacheStats stats() const { return mEntries.stats(); }
 

@@ -70,6 +70,12 @@ class LruCache {
     return mBytes;
   }
   std::size_t budget() const { return mBudget; }
+  /// Calls f(key) for every entry, under the cache's lock (f must not call the cache).
+  template <class F>
+  void forEachKey(F&& f) const {
+    std::lock_guard lock(mMutex);
+    for (const Entry& entry : mOrder) f(entry.key);
+  }
   CacheStats stats() const {
     std::lock_guard lock(mMutex);
     CacheStats s = mStats;

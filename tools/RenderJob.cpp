@@ -25,17 +25,6 @@ std::string outputPathForFrame(const std::string& pattern, int frame) {
   return out;
 }
 
-Camera defaultRenderCamera(BrickSource& source, int first, int last, std::uint32_t width, std::uint32_t height,
-                           glm::dvec3 up) {
-  Box bounds = occupiedBounds(source, first, last);
-  if (bounds.isEmpty()) bounds = Box{source.header().origin, source.header().domainMax()};
-  try {
-    return frameOnBox(bounds, double(width) / height, up);
-  } catch (const InputError& e) {
-    throw FileError(source.name(), e.what());
-  }
-}
-
 std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
   BrickStore store = BrickStore::open(job.store);
   const std::vector<int> stored = store.frames();
@@ -53,21 +42,8 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
     throw InputError("-o: rendering frames " + std::to_string(first) + "-" + std::to_string(last) +
                      " needs '#' in the output name (e.g. out_####.exr)");
 
-  RenderSettings settings = job.settings;
-  settings.radius = job.radius.value_or(defaultSphereRadius(store.header(), settings.jitter));
-  SurfaceSettings surface = job.surface;
-  surface.up = job.up;
+  const auto [settings, surface] = resolve(job, store);
   const StoreHeader& header = store.header();
-  const bool hasAttribute = header.attribute != AttributeKind::None;
-  if (job.colorByAttribute.value_or(false) && !hasAttribute)
-    throw InputError(job.store +
-                     ": the store has no per-particle attribute to colour by (--color-by attribute); "
-                     "convert with --attribute NAME");
-  surface.shading.colorByAttribute =
-      job.colorByAttribute.value_or(surface.shading.mode == ShadingMode::Attribute && hasAttribute);
-  if (surface.shading.colorByAttribute && !surface.shading.colorRange)
-    if (const auto range = store.attributeRange(); range && range->max > range->min)
-      surface.shading.colorRange = glm::vec2(range->min, range->max);
   std::string fallback;
   FramePipeline pipeline(store, job.device, settings, surface, &fallback);
   FrameRenderer& renderer = pipeline.renderer();

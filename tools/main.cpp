@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   tools::addBenchCommand(app);
   tools::addRenderCommand(app);
   tools::addDemoCommand(app);
+  tools::addViewCommand(app);
   tools::addFarmCommand(app);
   try {
     app.parse(argc, argv);

@@ -572,6 +572,21 @@ bool BrickStore::removeIfFrameless(const std::filesystem::path& dir, const Store
   return std::filesystem::remove(headerPath, ec);
 }
 
+bool BrickStore::reloadFrameTable() {
+  const auto headerPath = mDir / kStoreHeaderName;
+  std::vector<int> onDisk;
+  std::optional<AttributeRange> range;
+  const StoreHeader now = parseStoreHeader(readFile(headerPath), headerPath, &onDisk, &range);
+  if (now.id != mHeader.id)
+    throw FileError(headerPath, "is now the header of another store (store " + storeIdText(now.id) + ", not " +
+                                    storeIdText(mHeader.id) + "): it was converted anew; open it again");
+  std::lock_guard lock(mShared->mutex);
+  const std::size_t before = mShared->frames.size();
+  mShared->frames.insert(onDisk.begin(), onDisk.end());
+  if (range) mShared->range = range;
+  return mShared->frames.size() != before;
+}
+
 std::vector<int> BrickStore::frames() const {
   std::lock_guard lock(mShared->mutex);
   return {mShared->frames.begin(), mShared->frames.end()};

@@ -214,6 +214,11 @@ class BrickStore {
   /// FileError for a version 3 store with a missing or damaged frame.
   std::optional<AttributeRange> attributeRange() const;
 
+  /// Re-reads the frame table from store.fsh and adds the frames that other writers listed
+  /// since (what a viewer does while a convert fills the store). Returns whether any was added.
+  /// Thread safe. Throws FileError when store.fsh is unreadable or now another store's.
+  bool reloadFrameTable();
+
   /// Lists `frame` in the frame table, widening the attribute range by `stats` (rewrites store.fsh
   /// atomically when either changes). Called after the frame file is committed. Under the table
   /// lock, merging the frames other writers listed meanwhile (StoreLock.h). Throws FileError,

@@ -1,0 +1,36 @@
+#include "pipeline/RenderRequest.h"
+
+#include "core/Error.h"
+
+namespace flipscope {
+
+ResolvedRender resolve(const RenderRequest& request, const BrickStore& store) {
+  ResolvedRender out{request.settings, request.surface};
+  const StoreHeader& header = store.header();
+  out.settings.radius = request.radius.value_or(defaultSphereRadius(header, out.settings.jitter));
+  out.surface.up = request.up;
+  const bool hasAttribute = header.attribute != AttributeKind::None;
+  if (request.colorByAttribute.value_or(false) && !hasAttribute)
+    throw InputError(store.directory().string() +
+                     ": the store has no per-particle attribute to colour by (--color-by attribute); "
+                     "convert with --attribute NAME");
+  out.surface.shading.colorByAttribute =
+      request.colorByAttribute.value_or(out.surface.shading.mode == ShadingMode::Attribute && hasAttribute);
+  if (out.surface.shading.colorByAttribute && !out.surface.shading.colorRange)
+    if (const auto range = store.attributeRange(); range && range->max > range->min)
+      out.surface.shading.colorRange = glm::vec2(range->min, range->max);
+  return out;
+}
+
+Camera defaultRenderCamera(BrickSource& source, int first, int last, std::uint32_t width, std::uint32_t height,
+                           glm::dvec3 up) {
+  Box bounds = occupiedBounds(source, first, last);
+  if (bounds.isEmpty()) bounds = Box{source.header().origin, source.header().domainMax()};
+  try {
+    return frameOnBox(bounds, double(width) / height, up);
+  } catch (const InputError& e) {
+    throw FileError(source.name(), e.what());
+  }
+}
+
+}  // namespace flipscope
