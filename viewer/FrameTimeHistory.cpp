@@ -1,13 +1,10 @@
 #include "viewer/FrameTimeHistory.h"
 
-#include <algorithm>
-
 namespace flipscope::viewer {
 
 void FrameTimeHistory::add(double timeSeconds, double frameMs, std::uint64_t bricksUploaded) {
   mSamples.push_back({timeSeconds, float(frameMs), float(bricksUploaded)});
   while (!mSamples.empty() && mSamples.front().time < timeSeconds - mSeconds) mSamples.pop_front();
-  mLongestMs = std::max(mLongestMs, frameMs);
   ++mFrames;
 }
 

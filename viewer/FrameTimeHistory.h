@@ -1,5 +1,5 @@
 // FrameTimeHistory: the viewer's recent frames for its plots (like Reichl et al. 2014 Fig. 13:
-// frame time and bricks uploaded per frame over the last seconds), and the longest frame seen.
+// frame time and bricks uploaded per frame over the last seconds).
 #pragma once
 
 #include <cstdint>
@@ -20,8 +20,7 @@ class FrameTimeHistory {
   std::vector<float> bricksUploaded() const;
   /// Frames per second over the kept frames (0 with fewer than two).
   double fps() const;
-  /// The longest frame since construction, and how many frames were added.
-  double longestMs() const { return mLongestMs; }
+  /// How many frames were added since construction.
   std::uint64_t frames() const { return mFrames; }
 
  private:
@@ -32,7 +31,6 @@ class FrameTimeHistory {
   };
   double mSeconds;
   std::deque<Sample> mSamples;
-  double mLongestMs = 0;
   std::uint64_t mFrames = 0;
 };
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include <glm/geometric.hpp>
@@ -161,37 +162,61 @@ TEST_P(ViewNavigationTest, FlyMovesEyeAndTargetTogether) {
   EXPECT_NEAR(glm::dot(move, GetParam().up), 0.75 + 2 * glm::dot(start.forward(), GetParam().up), kTolerance);
 }
 
-TEST_P(ViewNavigationTest, FrameFitsTheBoxTightly) {
+/// The largest share of the image's half-width or half-height a corner of `box` takes as seen
+/// by `camera` (image aspect `aspect`): below 1 when all corners are inside the frustum.
+double cornerFill(const Camera& camera, const Box& box, double aspect) {
+  const double tanY = std::tan(glm::radians(camera.fovYDegrees) / 2), tanX = tanY * aspect;
+  double fill = 0;
+  for (int corner = 0; corner < 8; ++corner) {
+    const glm::dvec3 c(corner & 1 ? box.max.x : box.min.x, corner & 2 ? box.max.y : box.min.y,
+                       corner & 4 ? box.max.z : box.min.z);
+    const glm::dvec3 rel = c - camera.eye;
+    const double depth = glm::dot(rel, camera.forward());
+    if (!(depth > 0)) return std::numeric_limits<double>::infinity();
+    fill = std::max({fill, std::abs(glm::dot(rel, camera.right())) / depth / tanX,
+                     std::abs(glm::dot(rel, camera.trueUp())) / depth / tanY});
+  }
+  return fill;
+}
+
+/// `navigation` looking along `direction` from wherever its target is.
+void lookAlong(ViewNavigation& navigation, glm::dvec3 direction) {
+  Camera camera = navigation.camera();
+  camera.eye = camera.target - glm::normalize(direction) * 7.0;
+  navigation.setCamera(camera);
+}
+
+TEST_P(ViewNavigationTest, FrameFitsTheBoundingSphereWithItsMargin) {
   const glm::dvec3 directions[] = {{1, 0.3, -0.2}, {-0.4, -1, 0.5}, {0.3, 0.2, 1}};
   const Box box{{-3, 10, 4}, {5, 12, 4.5}};
   for (const double aspect : {0.5, 1.0, 2.5}) {
     for (const glm::dvec3& direction : directions) {
       ViewNavigation navigation(home(), GetParam().up);
-      Camera camera = navigation.camera();
-      camera.eye = camera.target - direction * 7.0;
-      navigation.setCamera(camera);
+      lookAlong(navigation, direction);
       navigation.frame(box, aspect);
       const Camera& framed = navigation.camera();
       expectNear(framed.forward(), glm::normalize(direction));
       expectNear(framed.target, (box.min + box.max) * 0.5);
-      const double tanY = std::tan(glm::radians(framed.fovYDegrees) / 2), tanX = tanY * aspect;
-      double fill = 0;  // the largest share of the half-width or half-height a corner takes
-      for (int corner = 0; corner < 8; ++corner) {
-        const glm::dvec3 c(corner & 1 ? box.max.x : box.min.x, corner & 2 ? box.max.y : box.min.y,
-                           corner & 4 ? box.max.z : box.min.z);
-        const glm::dvec3 rel = c - framed.eye;
-        const double depth = glm::dot(rel, framed.forward());
-        ASSERT_GT(depth, 0);
-        fill = std::max({fill, std::abs(glm::dot(rel, framed.right())) / depth / tanX,
-                         std::abs(glm::dot(rel, framed.trueUp())) / depth / tanY});
-      }
-      EXPECT_LT(fill, 1) << "aspect " << aspect;
-      EXPECT_GT(fill, 0.6) << "aspect " << aspect;
+      EXPECT_LT(cornerFill(framed, box, aspect), 1) << "aspect " << aspect;
       // The bounding sphere, 5% larger, touches the narrower side of the frustum.
-      const double halfAngle = std::min(std::atan(tanX), std::atan(tanY));
+      const double tanY = std::tan(glm::radians(framed.fovYDegrees) / 2);
+      const double halfAngle = std::min(std::atan(tanY * aspect), std::atan(tanY));
       const double radius = glm::length(box.extent()) / 2;
-      EXPECT_NEAR(std::asin(1.05 * radius / navigation.distance()), halfAngle, 1e-9);
+      EXPECT_NEAR(std::asin(1.05 * radius / navigation.distance()), halfAngle, 1e-9) << "aspect " << aspect;
     }
+  }
+}
+
+TEST_P(ViewNavigationTest, FrameIsTightOnACubeSeenAlongItsDiagonal) {
+  // The cube's silhouette nearly fills its bounding sphere's: a corner comes near the edge.
+  const Box cube{{-1, 6, -1}, {1, 8, 1}};
+  for (const glm::dvec3& direction : {glm::dvec3(1, 1, 1), glm::dvec3(-1, 1, -1), glm::dvec3(1, -1, -1)}) {
+    ViewNavigation navigation(home(), GetParam().up);
+    lookAlong(navigation, direction);
+    navigation.frame(cube, 1);
+    const double fill = cornerFill(navigation.camera(), cube, 1);
+    EXPECT_LT(fill, 1);
+    EXPECT_GT(fill, 0.75);
   }
 }
 

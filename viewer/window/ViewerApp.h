@@ -105,10 +105,13 @@ class ViewerApp {
   StageTimes mLastStages;
   double mFrameStartedMs = 0;   ///< clock of the current frame's begin()
   double mConvergeMs = 0;       ///< begin() to finished of the last converged frame
+  double mLongestConvergeMs = 0;
   std::uint64_t mConverged = 0;  ///< frames (begin()s) that converged
   std::uint64_t mUploadedThisFrame = 0;
 
   FrameTimeHistory mHistory;
+  double mStartupMs = -1;   ///< from start until the first image was shown
+  double mLongestUiMs = 0;  ///< the longest UI frame after the first image
   Clock::time_point mStart;
   bool mFlyMode = false;
   bool mDragging[3] = {false, false, false};
