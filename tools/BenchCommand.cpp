@@ -12,6 +12,7 @@ void addBenchCommand(CLI::App& app) {
   addBenchRenderCommand(*bench);
   addBenchSurfaceCommand(*bench);
   addBenchFarmCommand(*bench);
+  addBenchViewCommand(*bench);
 }
 
 }  // namespace flipscope::tools

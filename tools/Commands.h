@@ -29,7 +29,7 @@ void addConvertCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);
 void addInspectCommand(CLI::App& app);
 void addSynthCommand(CLI::App& app);
-void addBenchCommand(CLI::App& app);  // creates `bench` and calls the four below
+void addBenchCommand(CLI::App& app);  // creates `bench` and calls the ones below
 void addRenderCommand(CLI::App& app);
 void addDemoCommand(CLI::App& app);
 void addViewCommand(CLI::App& app);
@@ -41,5 +41,6 @@ void addBenchStreamingCommand(CLI::App& bench);
 void addBenchRenderCommand(CLI::App& bench);
 void addBenchSurfaceCommand(CLI::App& bench);
 void addBenchFarmCommand(CLI::App& bench);
+void addBenchViewCommand(CLI::App& bench);
 
 }  // namespace flipscope::tools
