@@ -36,3 +36,20 @@ done
 "$flipscope" render "$work/wave" -o "$out/synth20m-liquid.png" --size 640x360 -q
 "$flipscope" render "$work/wave" -o "$out/synth20m-unsmoothed.png" --size 640x360 --smoothing none -q
 echo "docs/make-images.sh: wrote $(ls "$out" | wc -l) pictures to $out"
+
+# The viewer's window (docs/images/viewer-window.png): `flipscope view` on Mantaflow frame 20 under
+# a private Xvfb, captured with xwd and cropped by ImageMagick (Debian: xvfb x11-apps
+# imagemagick); skipped when those are missing.
+if command -v Xvfb >/dev/null && command -v xwd >/dev/null && command -v convert >/dev/null; then
+  "$flipscope" convert "tests/data/mantaflow-dam64/data/fluid_data_0030.vdb" -o "$work/dam30" -q
+  Xvfb :87 -screen 0 1600x1000x24 >/dev/null 2>&1 &
+  xvfb=$!
+  sleep 1
+  printf '0 converge\n0.2 drag left 40 10\n0 converge\n3 quit\n' >"$work/events.txt"
+  DISPLAY=:87 "$flipscope" view "$work/dam30" --up z --size 900x500 --script "$work/events.txt" -q &
+  sleep 4
+  DISPLAY=:87 xwd -root -silent >"$work/window.xwd"
+  wait $! || true
+  kill "$xvfb"
+  convert "$work/window.xwd" -crop 900x500+0+0 "$out/viewer-window.png"
+fi
