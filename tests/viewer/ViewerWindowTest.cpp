@@ -183,7 +183,7 @@ TEST(ViewerWindow, ScrubbingWhileBricksConvertNeverBlocksTheWindowForLong) {
   EXPECT_GT(stats["frames_shown"].get<int>(), 10);
   // One slice: a ray-casting pass and the screen stages at 256x144 on the CPU (~0.15 s here, a
   // few times that under sanitizers), never a whole cold frame's conversion.
-  EXPECT_LT(longest, 1500.0);
+  EXPECT_LT(longest, 2000.0);
 }
 
 TEST(ViewerWindow, ClosingWhileAConversionRunsExitsCleanly) {
