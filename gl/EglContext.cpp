@@ -315,6 +315,10 @@ std::string currentRenderer() {
   return text(GL_VENDOR) + " / " + text(GL_RENDERER) + " / " + text(GL_VERSION);
 }
 
+bool isSoftwareRenderer(const std::string& renderer) {
+  return renderer.find("llvmpipe") != std::string::npos || renderer.find("softpipe") != std::string::npos;
+}
+
 void requireCurrentGl45(const std::string& what) {
   if (epoxy_gl_version() < 45)
     throw Unavailable(what + ": the current context is OpenGL " + std::to_string(epoxy_gl_version()) + ", need 45");

@@ -58,6 +58,9 @@ class EglContext {
 /// "GL_VENDOR / GL_RENDERER / GL_VERSION" of the context current on this thread (any context:
 /// EGL, or a window's GLX); one must be current.
 std::string currentRenderer();
+/// Whether `renderer` (as currentRenderer() gives it) is OpenGL on the CPU: Mesa's llvmpipe or
+/// softpipe.
+bool isSoftwareRenderer(const std::string& renderer);
 /// Throws Unavailable naming `what` when the context current on this thread (one must be) is
 /// below OpenGL 4.5.
 void requireCurrentGl45(const std::string& what);

@@ -48,15 +48,13 @@ GpuRaycaster::GpuRaycaster() : GpuRaycaster(gl::EglContext::create()) {}
 GpuRaycaster::GpuRaycaster(AdoptCurrentContext) : GpuRaycaster(gl::EglContext{}) {}
 
 GpuRaycaster::GpuRaycaster(gl::EglContext context) : mContext(std::move(context)) {
-  mPlatform = mContext.isValid() ? mContext.platform() : "window";
   if (!mContext.isValid()) gl::requireCurrentGl45("GpuRaycaster");
   mProgram = gl::Program::compute(gl::shaderSource("Raycast.comp"));
   GLint64 maxBlock = 0;
   glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxBlock);
   mMaxBufferBytes = std::uint64_t(maxBlock);
   // llvmpipe answers timer queries with ~0: time its passes on the wall clock instead.
-  const std::string renderer = gl::currentRenderer();
-  mSoftware = renderer.find("llvmpipe") != std::string::npos || renderer.find("softpipe") != std::string::npos;
+  mSoftware = gl::isSoftwareRenderer(gl::currentRenderer());
   mParams = makeBuffer(sizeof(RaycastParams));
   mFoam = makeBuffer(0);  // bound by every trace; a pool without foam never reads them
   mFoamOccupancy = makeBuffer(0);
@@ -64,7 +62,9 @@ GpuRaycaster::GpuRaycaster(gl::EglContext context) : mContext(std::move(context)
 
 GpuRaycaster::~GpuRaycaster() = default;
 
-std::string GpuRaycaster::name() const { return "OpenGL (" + mPlatform + "): " + gl::currentRenderer(); }
+std::string GpuRaycaster::name() const {
+  return "OpenGL (" + (mContext.isValid() ? mContext.platform() : std::string("window")) + "): " + gl::currentRenderer();
+}
 
 void GpuRaycaster::allocatePool(const PoolLayout& layout) {
   mLayout = layout;

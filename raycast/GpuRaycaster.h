@@ -46,8 +46,7 @@ class GpuRaycaster : public RaycastDevice {
  private:
   explicit GpuRaycaster(gl::EglContext context);
 
-  gl::EglContext mContext;  ///< empty when the context is adopted
-  std::string mPlatform;    ///< "device", "surfaceless", "default", or "window" when adopted
+  gl::EglContext mContext;  ///< empty when the context is adopted (name() says "window")
   gl::Program mProgram;
   gl::Program mFoamProgram;       ///< raycast/glsl/FoamClassify.comp, compiled on first use
   gl::Program mOccupancyProgram;  ///< raycast/glsl/FoamOccupancy.comp, likewise

@@ -74,8 +74,7 @@ ViewerApp::ViewerApp(const ViewerOptions& options) : mOptions(options), mStart(C
 
   // The device: the GPU pipeline in this window's context, unless that is software OpenGL.
   const std::string renderer = gl::currentRenderer();
-  const bool software = renderer.find("llvmpipe") != std::string::npos ||
-                        renderer.find("softpipe") != std::string::npos;
+  const bool software = gl::isSoftwareRenderer(renderer);
   if (mOptions.device == DeviceChoice::Gpu) {
     mGpu = true;
   } else if (mOptions.device == DeviceChoice::Auto) {
