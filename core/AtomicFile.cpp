@@ -242,20 +242,37 @@ void writeTextAtomically(const std::filesystem::path& destination, std::string_v
   writeFileAtomically(destination, std::as_bytes(std::span(text.data(), text.size())));
 }
 
-std::vector<std::byte> readFile(const std::filesystem::path& path) {
+namespace {
+/// The bytes of `path`, appended to `out` (a byte or char container); `what` names the file in
+/// errors ("" for none).
+template <class Bytes>
+void readWhole(const std::filesystem::path& path, std::string_view what, Bytes& out) {
+  const std::string named = what.empty() ? std::string() : " " + std::string(what);
   std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) throw FileError(path, "cannot open: " + errnoText());
-  std::vector<std::byte> bytes;
-  std::byte buffer[1 << 16];
+  if (!f) throw FileError(path, "cannot open" + named + ": " + errnoText());
+  char buffer[1 << 16];
   for (;;) {
     std::size_t n = std::fread(buffer, 1, sizeof buffer, f);
-    bytes.insert(bytes.end(), buffer, buffer + n);
+    const auto* begin = reinterpret_cast<const typename Bytes::value_type*>(buffer);
+    out.insert(out.end(), begin, begin + n);
     if (n < sizeof buffer) break;
   }
   bool failed = std::ferror(f);
   std::fclose(f);
-  if (failed) throw FileError(path, "read failed");
+  if (failed) throw FileError(path, "read failed" + (what.empty() ? std::string() : " (" + std::string(what) + ")"));
+}
+}  // namespace
+
+std::vector<std::byte> readFile(const std::filesystem::path& path) {
+  std::vector<std::byte> bytes;
+  readWhole(path, "", bytes);
   return bytes;
+}
+
+std::string readTextFile(const std::filesystem::path& path, std::string_view what) {
+  std::string text;
+  readWhole(path, what, text);
+  return text;
 }
 
 void syncDirectory(const std::filesystem::path& dir) {

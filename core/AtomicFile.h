@@ -118,6 +118,9 @@ void writeTextAtomically(const std::filesystem::path& destination, std::string_v
 
 /// Reads a whole file. Throws FileError when it cannot be opened or read.
 std::vector<std::byte> readFile(const std::filesystem::path& path);
+/// Reads a whole text file (a camera, a script). Throws FileError naming the file and `what` it
+/// is ("cannot open camera file: No such file or directory") when it cannot be opened or read.
+std::string readTextFile(const std::filesystem::path& path, std::string_view what);
 
 /// fsyncs a directory so that a rename inside it is durable.
 void syncDirectory(const std::filesystem::path& dir);

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <fstream>
 #include <span>
 #include <sstream>
 #include <vector>
@@ -117,14 +116,7 @@ glm::dvec3 readVector(const nlohmann::json& json, const char* key, const std::fi
 }
 }  // namespace
 
-Camera loadCamera(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw FileError(file, "cannot open camera file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw FileError(file, "cannot read camera file");
-  return parseCameraJson(text.str(), file);
-}
+Camera loadCamera(const std::filesystem::path& file) { return parseCameraJson(readTextFile(file, "camera file"), file); }
 
 Camera parseCameraJson(std::string_view text, const std::filesystem::path& file) {
   nlohmann::json json;

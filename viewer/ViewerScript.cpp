@@ -3,9 +3,8 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
+#include "core/AtomicFile.h"
 #include "core/Error.h"
 
 namespace flipscope::viewer {
@@ -163,12 +162,7 @@ std::vector<ScriptEvent> parseViewerScript(std::string_view text, const std::fil
 }
 
 std::vector<ScriptEvent> loadViewerScript(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw FileError(file, "cannot open viewer script");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw FileError(file, "cannot read viewer script");
-  return parseViewerScript(text.str(), file);
+  return parseViewerScript(readTextFile(file, "viewer script"), file);
 }
 
 }  // namespace flipscope::viewer

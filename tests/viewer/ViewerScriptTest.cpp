@@ -149,6 +149,7 @@ TEST(ViewerScript, LoadsAFileAndNamesAMissingOne) {
   } catch (const FileError& error) {
     EXPECT_EQ(error.path(), missing);
     EXPECT_TRUE(hasSubstr(error.what(), missing.string()));
+    EXPECT_TRUE(hasSubstr(error.what(), "cannot open viewer script")) << error.what();
   }
 }
 
