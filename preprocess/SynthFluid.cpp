@@ -12,6 +12,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/Error.h"
+#include "preprocess/Convert.h"
 
 namespace flipscope {
 
@@ -283,6 +284,26 @@ bool SynthFluid::read(ParticleChunk& chunk, std::size_t maxParticles) {
   }
   mNext += n;
   return true;
+}
+
+BrickStore convertSynthFrames(SynthOptions options, int frames, const std::filesystem::path& storeDir,
+                              Progress* progress) {
+  options.frame = 0;
+  const SynthFluid first(options);
+  ConvertOptions convert;
+  convert.cellSize = first.cellSize();
+  convert.domain = first.domain();
+  convert.particleSpacing = first.cellSize() / 2;  // the body lattice
+  convert.progress = Progress::Mode::Silent;
+  std::filesystem::remove_all(storeDir);
+  BrickStore store =
+      BrickStore::createOrAppend(storeDir, makeStoreHeader(*convert.domain, convert, AttributeKind::Speed));
+  for (int f = 0; f < frames; ++f) {
+    options.frame = f;
+    SynthFluid fluid(options);
+    convertFrame(fluid, store, f, convert, progress);
+  }
+  return store;
 }
 
 }  // namespace flipscope

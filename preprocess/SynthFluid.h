@@ -21,7 +21,9 @@
 #include <glm/vec3.hpp>
 
 #include "core/Box.h"
+#include "core/Progress.h"
 #include "preprocess/particles/ParticleSource.h"
+#include "preprocess/store/BrickStore.h"
 
 namespace flipscope {
 
@@ -109,5 +111,12 @@ class SynthFluid : public ParticleSource {
   std::uint64_t mBodyCount = 0, mSheetCount = 0, mSprayCount = 0;
   std::uint64_t mNext = 0;
 };
+
+/// Bins frames [0, frames) of the synth fluid of `options` (options.frame is ignored) into a new
+/// store at `storeDir` (what was there is replaced): the first frame's domain and cell size, the
+/// body lattice (cellSize() / 2) as the particle spacing, the speed as the attribute. What `demo`
+/// and `bench view` render. `progress`, when given, counts the particles.
+BrickStore convertSynthFrames(SynthOptions options, int frames, const std::filesystem::path& storeDir,
+                              Progress* progress = nullptr);
 
 }  // namespace flipscope

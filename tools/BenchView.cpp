@@ -19,7 +19,6 @@
 #include "core/Error.h"
 #include "pipeline/FramePipeline.h"
 #include "pipeline/RenderRequest.h"
-#include "preprocess/Convert.h"
 #include "preprocess/SynthFluid.h"
 #include "raycast/CpuRaycaster.h"
 #include "tools/CliValues.h"
@@ -115,26 +114,12 @@ void runBenchView(const BenchViewArgs& a) {
   const fs::path work = a.workDir.empty() ? fs::temp_directory_path() / "flipscope-bench-view" : fs::path(a.workDir);
   fs::create_directories(work);
   const fs::path storeDir = work / "store";
-  fs::remove_all(storeDir);
   SynthOptions synth;
   synth.particles = parseCount("--particles", a.particles);
   if (!a.json)
     std::fprintf(stderr, "bench view: %d synth frames of %s particles -> %s ...\n", a.frames,
                  Progress::humanCount(double(synth.particles)).c_str(), storeDir.c_str());
-  {
-    SynthFluid first(synth);
-    ConvertOptions options;
-    options.cellSize = first.cellSize();
-    options.domain = first.domain();
-    options.progress = Progress::Mode::Silent;
-    BrickStore store =
-        BrickStore::createOrAppend(storeDir, makeStoreHeader(*options.domain, options, AttributeKind::Speed));
-    for (int f = 0; f < a.frames; ++f) {
-      synth.frame = f;
-      SynthFluid fluid(synth);
-      convertFrame(fluid, store, f, options);
-    }
-  }
+  convertSynthFrames(synth, a.frames, storeDir);
   std::vector<ViewRates> results;
   for (const std::string& device : {std::string("cpu"), std::string("gpu")}) {
     if (a.devices.find(device) == std::string::npos) continue;

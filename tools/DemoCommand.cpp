@@ -8,7 +8,6 @@
 #include <tuple>
 
 #include "core/Error.h"
-#include "preprocess/Convert.h"
 #include "preprocess/store/StoreInspection.h"
 #include "preprocess/SynthFluid.h"
 #include "tools/CliValues.h"
@@ -31,26 +30,16 @@ struct DemoArgs {
 void runDemo(const DemoArgs& a) {
   const fs::path out = a.output;
   const fs::path storeDir = out / "store";
-  fs::remove_all(storeDir);
   fs::create_directories(out);
 
   SynthOptions synth;
   synth.particles = parseCount("--particles", a.particles);
-  SynthFluid first(synth);
-  ConvertOptions options;
-  options.cellSize = first.cellSize();
-  options.domain = first.domain();
-  options.particleSpacing = first.cellSize() / 2;  // the body lattice (SynthFluid.h)
-  StoreHeader header = makeStoreHeader(*options.domain, options, AttributeKind::Speed);
-  BrickStore store = BrickStore::createOrAppend(storeDir, header);
+  const SynthFluid first(synth);
   std::printf("demo: %d synth frames of %s particles (FLIP-like wave, sheets, spray) -> %s\n", a.frames,
               Progress::humanCount(double(first.count())).c_str(), storeDir.c_str());
   Progress progress("demo convert", first.count() * std::uint64_t(a.frames));
-  for (int f = 0; f < a.frames; ++f) {
-    synth.frame = f;
-    SynthFluid fluid(synth);
-    convertFrame(fluid, store, f, options, &progress);
-  }
+  BrickStore store = convertSynthFrames(synth, a.frames, storeDir, &progress);
+  const StoreHeader& header = store.header();
   progress.finish();
   for (int f : store.frames()) {
     const FrameSummary s = summarizeFrame(*store.frame(f), header);
