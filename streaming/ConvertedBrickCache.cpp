@@ -1,9 +1,8 @@
 // CPU brick cache (Reichl et al. 2014 §4.1) with optional in-memory zstd compression.
 #include "streaming/ConvertedBrickCache.h"
 
-#include <set>
-
 #include <cstring>
+#include <set>
 
 #include <zstd.h>
 

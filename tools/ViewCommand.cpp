@@ -21,6 +21,7 @@ struct ViewArgs {
   double scale = 0;
   double budgetMs = 25;
   int readAhead = 8;
+  int readDelayMs = 0;
   std::string screenshot;
   std::string script;
   std::string stats;
@@ -47,6 +48,8 @@ void runView(const ViewArgs& a) {
   o.budgetMs = a.budgetMs;
   if (a.readAhead < 0) throw InputError("--read-ahead: must be 0 or more");
   o.readAheadFrames = a.readAhead;
+  if (a.readDelayMs < 0) throw InputError("--read-delay-ms: must be 0 or more");
+  o.readDelayMs = a.readDelayMs;
   o.screenshot = a.screenshot;
   o.script = a.script;
   o.saveCamera = a.look.saveCamera;
@@ -83,6 +86,8 @@ void addViewCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--read-ahead", args->readAhead, "Frames prefetched in the playing direction, within --cpu-mem")
       ->capture_default_str();
+  cmd->add_option("--read-delay-ms", args->readDelayMs,
+                  "Wait this long before every brick read: try the viewer as on slow (network) storage");
   cmd->add_option("--screenshot", args->screenshot,
                   "Render the first frame once, converged, at --size, save it (.png or .exr) and exit");
   cmd->add_option("--script", args->script, "Timed input events to play (see README, \"The viewer\")");

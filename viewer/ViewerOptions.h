@@ -27,6 +27,7 @@ struct ViewerOptions {
   double resolutionScale = 0;
   double budgetMs = 25;               ///< ray-casting per displayed frame (--budget-ms)
   int readAheadFrames = 8;            ///< frames prefetched in the playing direction
+  int readDelayMs = 0;                ///< --read-delay-ms: every brick read waits this long (slow storage)
   std::filesystem::path screenshot;   ///< --screenshot: render once, converged, save, exit
   std::filesystem::path script;       ///< --script: timed input events (viewer/ViewerScript.h)
   std::filesystem::path saveCamera;   ///< where C writes the camera

@@ -4,8 +4,6 @@
 
 #include <GLFW/glfw3.h>
 
-#include <mutex>
-
 #include "gl/EglContext.h"
 
 namespace flipscope::viewer {

@@ -20,6 +20,7 @@
 #include "raycast/CpuRaycaster.h"
 #include "raycast/GpuRaycaster.h"
 #include "raycast/ImageWriter.h"
+#include "streaming/DelayedBrickSource.h"
 #include "viewer/window/DisplayTexture.h"
 #include "viewer/window/GlfwWindow.h"
 
@@ -47,6 +48,9 @@ std::string keyName(int key) {
     default: return "";
   }
 }
+
+/// W A S D Q E: the keys that move the camera in fly mode.
+bool isFlyKey(const std::string& name) { return name.size() == 1 && std::string_view("wasdqe").find(name[0]) != std::string_view::npos; }
 
 bool isStore(const std::vector<std::string>& inputs) {
   return inputs.size() == 1 && std::filesystem::is_directory(inputs.front());
@@ -164,15 +168,15 @@ bool ViewerApp::pollSource() {
         throw InputError(mStoreDir.string() + ": the store has no frame " + std::to_string(*mOptions.frame));
       mTimeline->seek(*mOptions.frame);
     }
-    const BrickStore& store = mSource->store();
-    mResolved = resolve(mOptions.request, store);
-    mLook.filter = mResolved.surface.smoothing.name;
-    mLook.iterations = mResolved.surface.smoothing.iterations;
-    mLook.strength = mResolved.surface.smoothing.strength;
-    mLook.foam = mResolved.settings.foam.mode;
-    mLook.radius = mResolved.settings.radius;
-    mLook.jitter = mResolved.settings.jitter > 0;
-    mLook.colorByAttribute = mResolved.surface.shading.colorByAttribute;
+    // The panel starts from what the command line asked, resolved against the store.
+    const ResolvedRender resolved = resolve(mOptions.request, mSource->store());
+    mLook.filter = resolved.surface.smoothing.name;
+    mLook.iterations = resolved.surface.smoothing.iterations;
+    mLook.strength = resolved.surface.smoothing.strength;
+    mLook.foam = resolved.settings.foam.mode;
+    mLook.radius = resolved.settings.radius;
+    mLook.jitter = resolved.settings.jitter > 0;
+    mLook.colorByAttribute = resolved.surface.shading.colorByAttribute;
     const glm::uvec2 size = renderSize();
     const Camera home =
         mOptions.camera ? *mOptions.camera
@@ -196,28 +200,29 @@ glm::uvec2 ViewerApp::renderSize() const {
 void ViewerApp::buildPipeline() {
   const glm::uvec2 size = renderSize();
   if (mPipeline && mBuiltLook == mLook && mBuiltSize == size) return;
-  RenderSettings settings = mResolved.settings;
-  settings.width = size.x;
-  settings.height = size.y;
-  settings.radius = mLook.radius;
-  settings.jitter = mLook.jitter ? (mResolved.settings.jitter > 0 ? mResolved.settings.jitter : 0.25f) : 0.0f;
-  settings.foam.mode = mLook.foam;
-  settings.readAheadFrames = mOptions.readAheadFrames;
-  SurfaceSettings surface = mResolved.surface;
-  surface.smoothing.name = mLook.filter;
-  surface.smoothing.iterations = mLook.iterations;
-  surface.smoothing.strength = mLook.strength;
-  surface.shading.colorByAttribute = mLook.colorByAttribute;
-  if (mLook.colorByAttribute && !surface.shading.colorRange)
-    if (const auto range = mSource->store().attributeRange(); range && range->max > range->min)
-      surface.shading.colorRange = glm::vec2(range->min, range->max);
+  // The command line's request with the panel's look, resolved as `render` resolves it.
+  RenderRequest request = mOptions.request;
+  request.settings.width = size.x;
+  request.settings.height = size.y;
+  request.settings.jitter =
+      mLook.jitter ? (mOptions.request.settings.jitter > 0 ? mOptions.request.settings.jitter : RenderSettings{}.jitter)
+                   : 0.0f;
+  request.settings.foam.mode = mLook.foam;
+  request.settings.readAheadFrames = mOptions.readAheadFrames;
+  request.radius = mLook.radius;
+  request.surface.smoothing = {mLook.filter, mLook.iterations, mLook.strength};
+  request.colorByAttribute = mLook.colorByAttribute;
+  const auto [settings, surface] = resolve(request, mSource->store());
   mPipeline.reset();
   std::unique_ptr<RaycastDevice> raycaster;
   if (mGpu)
     raycaster = std::make_unique<GpuRaycaster>(GpuRaycaster::AdoptCurrentContext{});
   else
     raycaster = std::make_unique<CpuRaycaster>();
-  mPipeline = std::make_unique<FramePipeline>(mSource, std::move(raycaster), settings, surface);
+  std::shared_ptr<BrickSource> source = mSource;
+  if (mOptions.readDelayMs > 0)
+    source = std::make_shared<DelayedBrickSource>(mSource, std::chrono::milliseconds(mOptions.readDelayMs));
+  mPipeline = std::make_unique<FramePipeline>(std::move(source), std::move(raycaster), settings, surface);
   mDeviceName = mPipeline->deviceName();
   mBuiltLook = mLook;
   mBuiltSize = size;
@@ -231,7 +236,7 @@ void ViewerApp::buildPipeline() {
 void ViewerApp::onKey(const std::string& name) {
   if (!mNavigation || !mTimeline) return;
   const double flyStep = mNavigation->distance() * 0.05;
-  if (mFlyMode && name.size() == 1 && std::string("wasdqe").find(name[0]) != std::string::npos) {
+  if (mFlyMode && isFlyKey(name)) {
     const char k = name[0];
     mNavigation->fly(k == 'w' ? flyStep : k == 's' ? -flyStep : 0, k == 'd' ? flyStep : k == 'a' ? -flyStep : 0,
                      k == 'e' ? flyStep : k == 'q' ? -flyStep : 0);
@@ -290,7 +295,7 @@ void ViewerApp::keyCallback(GLFWwindow* window, int key, int, int action, int) {
   ViewerApp& app = *appOf(window);
   const std::string name = keyName(key);
   // Fly keys held down move every frame (step()); a press alone would move once more.
-  if (app.mFlyMode && name.size() == 1 && std::string("wasdqe").find(name[0]) != std::string::npos) return;
+  if (app.mFlyMode && isFlyKey(name)) return;
   if (!name.empty()) app.onKey(name);
 }
 
@@ -357,8 +362,7 @@ void ViewerApp::saveScreenshot(const std::filesystem::path& path) {
 }
 
 void ViewerApp::step(double dtSeconds) {
-  if (!mSource && !pollSource()) return;
-  if (mConversion || (mSource && msBetween(mLastReload, Clock::now()) > 1000)) pollSource();
+  if ((mConversion || !mSource) && !pollSource()) return;  // a store being filled: its new frames
   buildPipeline();
   if (mFlyMode && !ImGui::GetIO().WantCaptureKeyboard) {
     const double speed = mNavigation->distance() * dtSeconds;  // the distance to the target in a second
@@ -376,14 +380,13 @@ void ViewerApp::step(double dtSeconds) {
     mBegunFrame = mTimeline->frame();
     mRestart = false;
     mFrameStartedMs = msBetween(mStart, Clock::now());
-    mUploadedThisFrame = 0;
+    mProgress = {};  // the new frame's statistics start at zero
   }
   mUploadedThisFrame = 0;
   if (!mPipeline->finished()) {
     const std::uint64_t uploadedBefore = mProgress.stats.bricksUploaded;
     mProgress = mPipeline->advance(mOptions.budgetMs);
-    mUploadedThisFrame = mProgress.stats.bricksUploaded >= uploadedBefore ? mProgress.stats.bricksUploaded - uploadedBefore
-                                                                           : mProgress.stats.bricksUploaded;
+    mUploadedThisFrame = mProgress.stats.bricksUploaded - uploadedBefore;
     if (mProgress.changed) {
       mLastStages = mProgress.stages;
       const glm::uvec2 size = mBuiltSize;
@@ -398,6 +401,11 @@ void ViewerApp::step(double dtSeconds) {
       mLongestConvergeMs = std::max(mLongestConvergeMs, mConvergeMs);
     }
   }
+  // Counting the cached frames walks the whole CPU cache under its lock: twice a second is enough.
+  if (msBetween(mFramesCachedAt, Clock::now()) > 500) {
+    mFramesCached = mPipeline->renderer().streamer().cache().frames().size();
+    mFramesCachedAt = Clock::now();
+  }
   if (!mOptions.screenshot.empty() && mPipeline->finished()) {
     saveScreenshot(mOptions.screenshot);
     if (!mProgress.stats.converged) mExitCode = kExitNotConverged;
@@ -408,10 +416,20 @@ void ViewerApp::step(double dtSeconds) {
 int ViewerApp::run() {
   auto last = Clock::now();
   while (!glfwWindowShouldClose(mWindow->handle())) {
+    // Nothing to refine, play or convert: sleep until input (or a scripted event is due). Rays
+    // waiting for bricks: look again soon, leaving the cores to the conversion.
+    const bool busy = !mPipeline || mRestart || mConversion || mTimeline->playing();
+    const bool waiting = !busy && !mPipeline->finished() && !mProgress.changed;
+    if (!busy && mPipeline->finished())
+      glfwWaitEventsTimeout(mScriptNext < mScript.size() ? 0.01 : 0.25);
+    else if (waiting)
+      glfwWaitEventsTimeout(0.005);
+    else
+      glfwPollEvents();
+    // A UI frame is the work after the wait: what input waits for.
     const auto frameStart = Clock::now();
     const double dt = std::min(msBetween(last, frameStart) / 1000.0, 0.25);
     last = frameStart;
-    glfwPollEvents();
     runScript();
     step(dt);
 

@@ -88,10 +88,9 @@ class ViewerApp {
   std::filesystem::path mStoreDir;
   std::unique_ptr<CacheConversion> mConversion;
   std::string mConversionStatus;
-  Clock::time_point mLastReload{};
+  Clock::time_point mLastReload{};  ///< of the frame table, while a convert fills the store
   std::shared_ptr<StoreBrickSource> mSource;
   std::unique_ptr<FramePipeline> mPipeline;
-  ResolvedRender mResolved;
   ViewerLook mLook;
   ViewerLook mBuiltLook;
   glm::uvec2 mBuiltSize{0};
@@ -108,6 +107,8 @@ class ViewerApp {
   double mLongestConvergeMs = 0;
   std::uint64_t mConverged = 0;  ///< frames (begin()s) that converged
   std::uint64_t mUploadedThisFrame = 0;
+  std::size_t mFramesCached = 0;  ///< frames with bricks in the CPU cache, as of mFramesCachedAt
+  Clock::time_point mFramesCachedAt{};
 
   FrameTimeHistory mHistory;
   double mStartupMs = -1;   ///< from start until the first image was shown

@@ -92,7 +92,7 @@ void ViewerApp::drawPanel() {
                 (unsigned long long)s.bricksRequested, (unsigned long long)s.bricksUploaded, s.frameBricks);
     const ConvertedBrickCache& cache = mPipeline->renderer().streamer().cache();
     ImGui::Text("CPU cache %.1f / %.0f MB, %zu frames cached", double(cache.bytes()) / 1e6, double(cache.budget()) / 1e6,
-                cache.frames().size());
+                mFramesCached);
     ImGui::Text("GPU pool %.1f MB", double(s.poolBytes) / 1e6);
     ImGui::PlotLines("frame ms", samples.data(), int(samples.size()), 0, nullptr, 0.0f, FLT_MAX, ImVec2(0, 50));
     const auto bricks = mHistory.bricksUploaded();
