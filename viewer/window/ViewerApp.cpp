@@ -330,7 +330,8 @@ void ViewerApp::runScript() {
   if (mScriptNext == 0 && mScriptLast == Clock::time_point{}) mScriptLast = Clock::now();
   if (msBetween(mScriptLast, Clock::now()) < e.delaySeconds * 1000.0) return;
   if (e.kind == ScriptEvent::Kind::Converge && (!mPipeline || mRestart || !mPipeline->finished())) return;
-  if (e.kind != ScriptEvent::Kind::Converge && !mNavigation) return;  // waits for the first frame
+  // Events about the view wait for the first frame; quit does not.
+  if (e.kind != ScriptEvent::Kind::Converge && e.kind != ScriptEvent::Kind::Quit && !mNavigation) return;
   switch (e.kind) {
     case ScriptEvent::Kind::Key: onKey(e.key); break;
     case ScriptEvent::Kind::Drag: onDrag(e.button, e.delta.x, e.delta.y); break;
@@ -416,14 +417,20 @@ void ViewerApp::step(double dtSeconds) {
 int ViewerApp::run() {
   auto last = Clock::now();
   while (!glfwWindowShouldClose(mWindow->handle())) {
-    // Nothing to refine, play or convert: sleep until input (or a scripted event is due). Rays
-    // waiting for bricks: look again soon, leaving the cores to the conversion.
-    const bool busy = !mPipeline || mRestart || mConversion || mTimeline->playing();
-    const bool waiting = !busy && !mPipeline->finished() && !mProgress.changed;
-    if (!busy && mPipeline->finished())
-      glfwWaitEventsTimeout(mScriptNext < mScript.size() ? 0.01 : 0.25);
-    else if (waiting)
-      glfwWaitEventsTimeout(0.005);
+    // Sleep until input when nothing is left to refine or play (a scripted event, a converting
+    // store's next frame, or the first frame of one, wake it sooner); while rays wait for bricks,
+    // look again soon. Either way the cores go to the conversion, not to redrawing the same image.
+    double wait = 0;
+    if (!mPipeline) {
+      wait = 0.05;
+    } else if (!mRestart && !mTimeline->playing()) {
+      if (mPipeline->finished())
+        wait = mScriptNext < mScript.size() ? 0.01 : mConversion ? 0.1 : 0.25;
+      else if (!mProgress.changed)
+        wait = 0.005;
+    }
+    if (wait > 0)
+      glfwWaitEventsTimeout(wait);
     else
       glfwPollEvents();
     // A UI frame is the work after the wait: what input waits for.
