@@ -13,21 +13,21 @@ mkdir -p "$out"
 # The bundled Blender Mantaflow FLIP frame (tests/data), converted and rendered with defaults.
 vdb=tests/data/mantaflow-dam64/data/fluid_data_0030.vdb
 "$flipscope" convert "$vdb" -o "$work/dam" -q
-"$flipscope" render "$work/dam" -o "$out/mantaflow-liquid.png" --up z --size 640x360 -q
-"$flipscope" render "$work/dam" -o "$out/mantaflow-spheres.png" --up z --size 640x360 --shading spheres -q
-"$flipscope" render "$work/dam" -o "$out/mantaflow-unsmoothed.png" --up z --size 640x360 --smoothing none -q
+"$flipscope" render "$work/dam" -o "$out/mantaflow-liquid.png" --size 640x360 -q
+"$flipscope" render "$work/dam" -o "$out/mantaflow-spheres.png" --size 640x360 --shading spheres -q
+"$flipscope" render "$work/dam" -o "$out/mantaflow-unsmoothed.png" --size 640x360 --smoothing none -q
 
 # The same frame with Mantaflow's secondary particles (spray, foam, bubbles): foam as a volume
 # (the default), removed, and kept as spheres.
 secondary=tests/data/mantaflow-dam64/particles/fluid_particles_0030.vdb
 "$flipscope" convert "$vdb" "$secondary" -o "$work/dam-foam" -q
-"$flipscope" render "$work/dam-foam" -o "$out/mantaflow-foam-volume.png" --up z --size 640x360 -q
-"$flipscope" render "$work/dam-foam" -o "$out/mantaflow-foam-remove.png" --up z --size 640x360 --foam remove -q
-"$flipscope" render "$work/dam-foam" -o "$out/mantaflow-foam-keep.png" --up z --size 640x360 --foam keep -q
+"$flipscope" render "$work/dam-foam" -o "$out/mantaflow-foam-volume.png" --size 640x360 -q
+"$flipscope" render "$work/dam-foam" -o "$out/mantaflow-foam-remove.png" --size 640x360 --foam remove -q
+"$flipscope" render "$work/dam-foam" -o "$out/mantaflow-foam-keep.png" --size 640x360 --foam keep -q
 
 # The five filters side by side on the same frame and camera.
 for filter in rof bilateral curvature-flow narrow-range plane-fit; do
-  "$flipscope" render "$work/dam" -o "$out/filter-$filter.png" --up z --size 480x270 --smoothing "$filter" -q
+  "$flipscope" render "$work/dam" -o "$out/filter-$filter.png" --size 480x270 --smoothing "$filter" -q
 done
 
 # A large synth frame: 20 M particles of waves, sheets and spray.
@@ -46,7 +46,7 @@ if command -v Xvfb >/dev/null && command -v xwd >/dev/null && command -v convert
   xvfb=$!
   sleep 1
   printf '0 converge\n0.2 drag left 40 10\n0 converge\n3 quit\n' >"$work/events.txt"
-  DISPLAY=:87 "$flipscope" view "$work/dam30" --up z --size 900x500 --script "$work/events.txt" -q &
+  DISPLAY=:87 "$flipscope" view "$work/dam30" --size 900x500 --script "$work/events.txt" -q &
   sleep 4
   DISPLAY=:87 xwd -root -silent >"$work/window.xwd"
   wait $! || true

@@ -8,7 +8,7 @@ ResolvedRender resolve(const RenderRequest& request, const BrickStore& store) {
   ResolvedRender out{request.settings, request.surface};
   const StoreHeader& header = store.header();
   out.settings.radius = request.radius.value_or(defaultSphereRadius(header, out.settings.jitter));
-  out.surface.up = request.up;
+  out.surface.up = upAxisVector(request.up.value_or(header.upAxis));
   const bool hasAttribute = header.attribute != AttributeKind::None;
   if (request.colorByAttribute.value_or(false) && !hasAttribute)
     throw InputError(store.directory().string() +

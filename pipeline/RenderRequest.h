@@ -23,12 +23,14 @@ struct RenderRequest {
   /// and the store has one. When set, an unset surface.shading.colorRange becomes the store's
   /// attribute range.
   std::optional<bool> colorByAttribute;
-  glm::dvec3 up{0, 1, 0};       ///< the scene's up axis (the default camera's, the sky's)
+  /// The scene's up axis (the default camera's, the navigation's, the sky's); unset: the one
+  /// the store records (StoreHeader::upAxis), +y when it records none.
+  std::optional<UpAxis> up;
 };
 
 struct ResolvedRender {
   RenderSettings settings;
-  SurfaceSettings surface;
+  SurfaceSettings surface;  ///< surface.up: the scene's up axis, as a unit vector
 };
 
 /// The settings `request` gives for `store`. Throws InputError naming `store` when colour by

@@ -839,11 +839,20 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
   KindAttributes kindAttributes;
   bool kinds = false;
   std::vector<AttributeDesc> firstHeld;  // what the first file holds: for a kind attribute no file has
+  UpAxis filesUp = UpAxis::Unknown;       // the first file's that states one
+  std::string filesUpOrigin, filesUpConflict;
   for (const auto& input : inputs) {
     std::vector<std::unique_ptr<ParticleSource>> parts;
     kindAttributes.emplace_back();
     for (const auto& file : input.files) {
       parts.push_back(openParticleFile(file, probe));
+      if (const UpAxis up = parts.back()->upAxis(); up != UpAxis::Unknown) {
+        if (filesUp == UpAxis::Unknown)
+          filesUp = up, filesUpOrigin = file.string();
+        else if (up != filesUp && filesUpConflict.empty())
+          filesUpConflict = file.string() + " is " + std::string(upAxisName(up)) + " up, " + filesUpOrigin + " " +
+                            std::string(upAxisName(filesUp)) + " up";
+      }
       kindAttributes.back().push_back(kindAttributeOf(options.kindAttribute, *parts.back()));
       kinds = kinds || !kindAttributes.back().back().empty();
       if (&input == &inputs.front() && &file == &input.files.front()) firstHeld = parts.back()->attributes();
@@ -921,8 +930,15 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
                                   ": the store has no particle kinds; the inputs' kinds are not kept");
       }
       kinds = header.particleKinds;
+      if (options.upAxis && *options.upAxis != header.upAxis)
+        throw InputError(storeDir.string() + ": the store records " +
+                         (header.upAxis == UpAxis::Unknown ? std::string("no up axis")
+                                                           : std::string(upAxisName(header.upAxis)) + " up") +
+                         " (store version " + std::to_string(header.version) + "), not " +
+                         std::string(upAxisName(*options.upAxis)) + " (--up); convert into a new store to change it");
       report.cellSizeOrigin = "kept from the existing store";
       report.spacingOrigin = "the existing store";
+      report.upAxisOrigin = header.version >= 6 ? "the existing store" : "a store older than version 6 records none";
     } else if (directory.alone()) {
       // Left by an interrupted or failed first convert: removed while no other writer can
       // have joined it. (A store without frames that another writer is creating now is joined.)
@@ -962,6 +978,13 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
     }
     header = chooseHeader(bounds, options, attribute, spacing, report);
     header.particleKinds = kinds;
+    header.upAxis = options.upAxis.value_or(filesUp);
+    report.upAxisOrigin = options.upAxis                  ? "--up"
+                          : filesUp != UpAxis::Unknown ? "the conventions of " + filesUpOrigin
+                                                       : "the input files do not say; give --up";
+    if (!options.upAxis && !filesUpConflict.empty())
+      report.warnings.push_back("the inputs disagree on the up axis (" + filesUpConflict + "); the store records " +
+                                std::string(upAxisName(filesUp)) + " up (give --up to choose)");
   }
   std::optional<FramelessHeader> framelessHeader;
   std::optional<BrickStore> created;

@@ -93,6 +93,10 @@ struct ConvertOptions {
   /// file and the option. Appending keeps the store's kinds: a name given for a store without
   /// kinds is refused, and the kinds `auto` finds then are dropped with a warning.
   std::optional<std::string> kindAttribute;
+  /// The scene's up axis the store records (StoreHeader::upAxis): unset (`auto`): what the first
+  /// input file that states one says (ParticleSource::upAxis), else Unknown. Appending keeps the
+  /// store's; another axis asked for is refused.
+  std::optional<UpAxis> upAxis;
   int zstdLevel = 1;
   std::filesystem::path scratchDir;    ///< spill files; default: the store directory
   /// Add to the store at storeDir, which must exist, with its header: also a store with no
@@ -122,6 +126,9 @@ struct ConvertReport {
   std::string cellSizeOrigin;
   /// How header.particleSpacing was found, or why it is unknown (0).
   std::string spacingOrigin;
+  /// Where header.upAxis came from ("--up", the file that states it, "the existing store"),
+  /// or why it is unknown.
+  std::string upAxisOrigin;
   /// Worth telling the user (e.g. the fallback from the particle spacing to kDefaultResolution).
   std::vector<std::string> warnings;
 };

@@ -130,11 +130,10 @@ std::string describeAttribute(const StoreHeader& header) {
   return header.attributeName;
 }
 
-glm::dvec3 parseUpAxis(const std::string& option, const std::string& text) {
-  if (text == "x") return {1, 0, 0};
-  if (text == "y") return {0, 1, 0};
-  if (text == "z") return {0, 0, 1};
-  throw InputError(option + ": expected x, y or z, got '" + text + "'");
+std::optional<UpAxis> parseUpAxis(const std::string& option, const std::string& text) {
+  if (text == "auto") return std::nullopt;
+  if (const auto axis = parseUpAxisName(text)) return axis;
+  throw InputError(option + ": expected auto, x, y or z, got '" + text + "'");
 }
 
 std::string formatNumber17(double value) {

@@ -3,10 +3,12 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 
 #include "core/Box.h"
+#include "core/UpAxis.h"
 #include "preprocess/store/BrickStore.h"
 #include "raycast/GpuRaycaster.h"
 
@@ -22,8 +24,8 @@ Box parseBox(const std::string& option, const std::string& text);
 std::pair<std::uint32_t, std::uint32_t> parseImageSize(const std::string& option, const std::string& text);
 /// "auto", "gpu" or "cpu" (the `--device` of render, demo and bench render).
 DeviceChoice parseDeviceChoice(const std::string& option, const std::string& text);
-/// "x", "y" or "z" -> the unit axis (the `--up` of a default camera).
-glm::dvec3 parseUpAxis(const std::string& option, const std::string& text);
+/// `--up`: "x", "y" or "z"; "auto" (nullopt): what the store or the input files say.
+std::optional<UpAxis> parseUpAxis(const std::string& option, const std::string& text);
 /// A box as parseBox reads it, every number with 17 significant digits (read back exactly).
 std::string formatBox(const Box& box);
 /// A number with 17 significant digits (read back exactly).

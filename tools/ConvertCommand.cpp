@@ -27,6 +27,7 @@ struct ConvertArgs {
   std::string mem = "4G";
   std::string attribute = "auto";
   std::string kindAttribute = "auto";
+  std::string up = "auto";
   int zstdLevel = 1;
   std::string scratch;
   bool append = false;
@@ -45,6 +46,7 @@ void runConvert(const ConvertArgs& a) {
   options.memoryBudget = parseBytes("--mem", a.mem);
   if (a.attribute != "auto") options.attribute = a.attribute;
   if (a.kindAttribute != "auto") options.kindAttribute = a.kindAttribute;
+  options.upAxis = parseUpAxis("--up", a.up);
   options.zstdLevel = a.zstdLevel;
   options.scratchDir = a.scratch;
   options.append = a.append;
@@ -75,6 +77,7 @@ void runConvert(const ConvertArgs& a) {
                 report.spacingOrigin.c_str());
   else
     std::printf("particle spacing unknown (%s)\n", report.spacingOrigin.c_str());
+  std::printf("up axis %s (%s)\n", std::string(upAxisName(h.upAxis)).c_str(), report.upAxisOrigin.c_str());
   for (const auto& f : report.frames) {
     std::printf("  frame %d: %llu particles, %u bricks, %s bytes, %.2f s%s", f.frame,
                 (unsigned long long)f.stats.particles, f.bricks, Progress::humanCount(double(f.storeBytes)).c_str(),
@@ -122,6 +125,10 @@ void addConvertCommand(CLI::App& app) {
                   "Integer attribute holding each particle's type as Mantaflow's flags (2 spray, 4 bubble, 8 foam, "
                   "else liquid), stored as a kind per cell: auto (Blender Mantaflow's U of particles_secondary), "
                   "none, or an attribute name; inputs without it are liquid")
+      ->capture_default_str();
+  cmd->add_option("--up", args->up,
+                  "The scene's up axis the store records, which render and view frame with: auto (what the input "
+                  "files' conventions say: z for Blender, y for Houdini and RealFlow), x, y or z")
       ->capture_default_str();
   cmd->add_option("--zstd-level", args->zstdLevel, "zstd level of brick payloads")
       ->check(CLI::Range(-5, 19))

@@ -256,7 +256,7 @@ struct RenderFarmArgs {
   std::string store;
   std::string output;
   std::string size = "1280x720";
-  std::string up = "y";
+  std::string up = "auto";
   std::string cameraFile;
 };
 
@@ -293,7 +293,8 @@ void runFarmRender(const RenderFarmArgs& a, const std::vector<std::string>& extr
       camera = loadCamera(a.cameraFile);
     } else {
       StoreBrickSource source(opened);
-      camera = defaultRenderCamera(source, plan.frames.front(), plan.frames.back(), width, height, parseUpAxis("--up", a.up));
+      const UpAxis up = parseUpAxis("--up", a.up).value_or(opened.header().upAxis);
+      camera = defaultRenderCamera(source, plan.frames.front(), plan.frames.back(), width, height, upAxisVector(up));
     }
     if (!a.farm.dryRun) {
       fs::create_directories(farmDir);
@@ -384,7 +385,7 @@ void addFarmCommand(CLI::App& app) {
   addFarmOptions(r, render->farm);
   r->add_flag("--resume", render->farm.resume, "Submit only the frames whose image is missing");
   r->add_option("--size", render->size, "Image size WxH")->capture_default_str();
-  r->add_option("--up", render->up, "Up axis of the default camera (x, y or z)")->capture_default_str();
+  r->add_option("--up", render->up, "Up axis of the default camera: auto (the one the store records, else y), x, y or z")->capture_default_str();
   r->add_option("--camera-file", render->cameraFile, "Camera JSON (default: framed on every frame, as render does)");
   r->allow_extras();  // every other option goes to each task's render (e.g. --smoothing, --shading)
   r->footer("Other options are passed to every task's flipscope render.");

@@ -110,6 +110,8 @@ void runInfo(const InfoArgs& a) {
     j["attribute_kind"] = attributeKindName(h.attribute);
     j["attribute_range"] = range ? nlohmann::json::array({range->min, range->max}) : nlohmann::json(nullptr);
     j["particle_kinds"] = h.particleKinds;
+    // "x", "y" or "z"; null when the store records none (then render and view take y)
+    j["up_axis"] = h.upAxis == UpAxis::Unknown ? nlohmann::json(nullptr) : nlohmann::json(upAxisName(h.upAxis));
     j["store_id"] = storeIdText(h.id);
     j["frames_missing"] = missing;
     j["frames"] = nlohmann::json::array();
@@ -151,6 +153,10 @@ void runInfo(const InfoArgs& a) {
       std::printf("attribute  %s, %g to %g over the frames\n", describeAttribute(h).c_str(), range->min, range->max);
     else
       std::printf("attribute  %s\n", describeAttribute(h).c_str());
+    if (h.upAxis != UpAxis::Unknown)
+      std::printf("up axis    %s\n", std::string(upAxisName(h.upAxis)).c_str());
+    else
+      std::printf("up axis    not recorded (render and view take y unless given --up)\n");
     if (h.particleKinds)
       std::printf("kinds      a particle kind per cell; cells over the frames: %s\n\n",
                   describeKindCells(total.kindCells).c_str());

@@ -79,6 +79,8 @@ nlohmann::json inspectFile(const std::filesystem::path& path, bool headerOnly) {
   j["velocity"] = source->hasVelocity();
   const auto kind = source->kindAttribute();
   j["kind_attribute"] = kind ? nlohmann::json(*kind) : nlohmann::json(nullptr);
+  const UpAxis up = source->upAxis();  // null: the file's conventions do not say
+  j["up_axis"] = up == UpAxis::Unknown ? nlohmann::json(nullptr) : nlohmann::json(upAxisName(up));
 
   std::vector<Range> ranges(attributes.size());
   for (std::size_t a = 0; a < attributes.size(); ++a) {
@@ -188,6 +190,9 @@ void printFile(const nlohmann::json& j) {
   if (!j["kind_attribute"].is_null())
     std::printf("  kinds       %s: particle types (Mantaflow's flags), convert stores a kind per cell\n",
                 j["kind_attribute"].get<std::string>().c_str());
+  if (!j["up_axis"].is_null())
+    std::printf("  up axis     %s (the file's conventions; convert records it)\n",
+                j["up_axis"].get<std::string>().c_str());
 }
 
 void runInspect(const InspectArgs& a) {

@@ -75,7 +75,7 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
   if (job.camera) {
     camera = *job.camera;
   } else {
-    camera = defaultRenderCamera(renderer.source(), first, last, settings.width, settings.height, job.up);
+    camera = defaultRenderCamera(renderer.source(), first, last, settings.width, settings.height, surface.up);
   }
   if (!job.saveCamera.empty()) saveCamera(job.saveCamera, camera);
 

@@ -107,7 +107,9 @@ void addRenderLookOptions(CLI::App& command, RenderLookArgs& a) {
   auto* camera = cmd->add_option("--camera", args->camera, "ex,ey,ez,tx,ty,tz,ux,uy,uz,fov (world units, degrees)");
   cmd->add_option("--camera-file", args->cameraFile, "JSON {\"eye\", \"target\", \"up\", \"fov\"}")->excludes(camera);
   cmd->add_option("--save-camera", args->saveCamera, "Write the camera of the render to this JSON file (--camera-file reads it)");
-  cmd->add_option("--up", args->up, "Up axis of the default camera framed on the data (x, y or z)")
+  cmd->add_option("--up", args->up,
+                  "The scene's up axis, for the default camera framed on the data and the sky: auto (the one the "
+                  "store records, else y), x, y or z")
       ->capture_default_str();
   cmd->add_option("--radius", args->radius,
                   "Sphere radius in cells (default: the store's particle spacing, at least 1 cell)");

@@ -21,7 +21,7 @@ struct RenderLookArgs {
   std::string camera;
   std::string cameraFile;
   std::string saveCamera;
-  std::string up = "y";
+  std::string up = "auto";
   std::optional<float> radius;
   std::string smoothing = "rof";
   std::optional<int> smoothingIterations;

@@ -14,6 +14,8 @@
 
 #include <glm/vec3.hpp>
 
+#include "core/UpAxis.h"
+
 namespace flipscope {
 
 /// The type of one component of an attribute, as the file stores it.
@@ -92,6 +94,10 @@ class ParticleSource {
   /// Mantaflow's integer `U` of a points grid named `particles_secondary`. Of one file: a
   /// concatenation of sources has none.
   virtual std::optional<std::string> kindAttribute() const { return std::nullopt; }
+  /// The up axis the file's conventions imply, else Unknown: +z for Blender's fluid caches
+  /// (points grids named `particles`, `particles_secondary`), +y for Houdini and RealFlow.
+  /// What convert records in the store unless given `--up`. Of one file, like kindAttribute.
+  virtual UpAxis upAxis() const { return UpAxis::Unknown; }
 };
 
 struct ReadOptions {

@@ -120,6 +120,8 @@ class RealFlowReader final : public ParticleSource {
   std::string format() const override {
     return "RealFlow particle .bin version " + std::to_string(mVersion) + " (fluid '" + mFluidName + "')";
   }
+  /// RealFlow's world is +y up.
+  UpAxis upAxis() const override { return UpAxis::Y; }
   std::vector<AttributeDesc> attributes() const override { return mExposed; }
   bool hasVelocity() const override { return mHasVelocity; }
   std::optional<std::uint64_t> countHint() const override { return mCount; }

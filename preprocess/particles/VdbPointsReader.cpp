@@ -1000,6 +1000,14 @@ class VdbPointsReader final : public ParticleSource {
     if (secondary && typed) return std::string("U");
     return std::nullopt;
   }
+  /// Blender's fluid caches name their points grids `particles` (the FLIP particles) and
+  /// `particles_secondary` (spray, foam, bubbles), and Blender's world is +z up.
+  UpAxis upAxis() const override {
+    const bool blender = !mGrids.empty() && std::all_of(mGrids.begin(), mGrids.end(), [](const PointGrid& g) {
+      return g.name == "particles" || g.name == "particles_secondary";
+    });
+    return blender ? UpAxis::Z : UpAxis::Unknown;
+  }
 
   bool read(ParticleChunk& chunk, std::size_t maxParticles) override {
     FLIPSCOPE_CHECK(maxParticles > 0);

@@ -26,10 +26,11 @@ constexpr char kStoreMagic[8] = {'F', 'S', 'S', 'T', 'O', 'R', 'E', '1'};
 /// Fixed part of store.fsh: magic .. particle spacing, store id, run count; then 8 bytes a run
 /// of the frame table, then the checksum. Version 4 adds the attribute name (length and bytes)
 /// and the attribute range (flag, min, max) before the run count, version 5 the particle kinds
-/// flag after them.
+/// flag after them, version 6 the up axis after that.
 constexpr std::size_t kStoreHeaderFixedBytes = 8 + 4 + 4 + 8 + 24 + 12 + 4 + 8 + 16 + 4;
 constexpr std::size_t kStoreHeaderV4Bytes = 4 + 4 + 4 + 4;
 constexpr std::size_t kStoreHeaderV5Bytes = 4;
+constexpr std::size_t kStoreHeaderV6Bytes = 4;
 /// The footer's version field, counted back from the end of the file.
 constexpr std::uint64_t kFooterVersionFromEnd = 24;
 
@@ -202,6 +203,7 @@ std::vector<std::byte> serializeStoreHeader(const StoreHeader& h, const std::vec
                                             const std::optional<AttributeRange>& range) {
   FLIPSCOPE_CHECK(h.attributeName.size() <= kMaxAttributeNameBytes, h.attributeName.size());
   FLIPSCOPE_CHECK(!h.particleKinds || h.version >= 5, "particle kinds in a version " << h.version << " store");
+  FLIPSCOPE_CHECK(h.upAxis == UpAxis::Unknown || h.version >= 6, "an up axis in a version " << h.version << " store");
   const bool v3 = h.version == 3;
   ByteWriter w;
   w.append(kStoreMagic, sizeof kStoreMagic);
@@ -225,6 +227,7 @@ std::vector<std::byte> serializeStoreHeader(const StoreHeader& h, const std::vec
     w.put(range ? range->max : 0.0f);
   }
   if (h.version >= 5) w.put(std::uint32_t(h.particleKinds ? 1 : 0));
+  if (h.version >= 6) w.put(static_cast<std::uint32_t>(h.upAxis));
   const auto runs = runsOf(frames);
   w.put(std::uint32_t(runs.size()));
   for (const FrameRun& run : runs) {
@@ -233,7 +236,8 @@ std::vector<std::byte> serializeStoreHeader(const StoreHeader& h, const std::vec
   }
   w.put(checksum64(w.view()));
   FLIPSCOPE_CHECK(w.size() == kStoreHeaderFixedBytes + (v3 ? 0 : kStoreHeaderV4Bytes + h.attributeName.size()) +
-                                  (h.version >= 5 ? kStoreHeaderV5Bytes : 0) + 8 * runs.size() + 8,
+                                  (h.version >= 5 ? kStoreHeaderV5Bytes : 0) +
+                                  (h.version >= 6 ? kStoreHeaderV6Bytes : 0) + 8 * runs.size() + 8,
                   w.size());
   return std::move(w.bytes());
 }
@@ -279,6 +283,11 @@ StoreHeader parseStoreHeader(std::span<const std::byte> bytes, const std::filesy
     const auto kinds = r.get<std::uint32_t>("particle kinds flag");
     if (kinds > 1) r.fail("particle kinds flag", "neither 0 nor 1");
     h.particleKinds = kinds == 1;
+  }
+  if (h.version >= 6) {
+    const auto up = r.get<std::uint32_t>("up axis");
+    if (up > static_cast<std::uint32_t>(UpAxis::Z)) r.fail("up axis", "unknown up axis " + std::to_string(up));
+    h.upAxis = UpAxis(up);
   }
   const auto runCount = r.get<std::uint32_t>("frame table runs");
   if (runCount > r.remaining() / 8) r.fail("frame table runs", "more runs than the file holds");

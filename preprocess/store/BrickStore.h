@@ -6,7 +6,8 @@
 //   store.fsh               StoreHeader: format version, domain, cell size, brick size, particle
 //                           spacing, the store's random 128-bit id, the per-particle attribute
 //                           (its kind and name) and its range over the frames, whether bricks
-//                           carry particle kinds (version 5), and the frame table
+//                           carry particle kinds (version 5), the scene's up axis (version 6),
+//                           and the frame table
 //   frame_NNNNNN.fsf        one file per frame: brick payloads, then octree, brick table, footer
 //   store.lock              the writers' locks (StoreLock.h); readers ignore it
 // Every file is written atomically (AtomicFile). The frame table in store.fsh lists the frames
@@ -45,6 +46,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "core/UpAxis.h"
 #include "preprocess/store/ParticleKind.h"
 #include "preprocess/store/PresenceOctree.h"
 
@@ -55,9 +57,11 @@ namespace flipscope {
 /// and the store's attribute range in store.fsh; frame files unchanged but for their version.
 /// 5: StoreHeader::particleKinds in store.fsh, a kind per cell in the payloads of such stores,
 /// and FrameStats::kindCells in the frame footer (136 bytes, 104 before).
-/// Version 3 and 4 stores are read and appended to as what they are (no kinds; version 3: speed
-/// or no attribute, its range gathered from the frames); older ones are refused (convert again).
-inline constexpr std::uint32_t kStoreVersion = 5;
+/// 6: StoreHeader::upAxis in store.fsh; frame files unchanged but for their version.
+/// Version 3 to 5 stores are read and appended to as what they are (no up axis; version 3 and 4:
+/// no kinds; version 3: speed or no attribute, its range gathered from the frames); older ones
+/// are refused (convert again).
+inline constexpr std::uint32_t kStoreVersion = 6;
 inline constexpr std::uint32_t kOldestStoreVersion = 3;
 inline constexpr char kStoreHeaderName[] = "store.fsh";
 /// Frame numbers a store holds: 0 to kMaxFrame (six digits in the file name).
@@ -104,6 +108,10 @@ struct StoreHeader {
   /// Every brick carries a ParticleKind per occupied cell (DecodedBrick::kinds). Version 5 only.
   /// convert quantizes the attribute of such stores to 14 bits (BrickBinning.h).
   bool particleKinds = false;
+  /// The scene's up axis as convert learnt it (`convert --up`, else the input files'
+  /// conventions: ParticleSource::upAxis); what `render` and `view` frame with unless given
+  /// `--up`. Version 6 only; Unknown in older stores and when nobody said.
+  UpAxis upAxis = UpAxis::Unknown;
 
   glm::dvec3 domainMax() const { return origin + glm::dvec3(brickGrid) * double(brickSize) * cellSize; }
   std::uint32_t cellsPerBrick() const { return brickSize * brickSize * brickSize; }

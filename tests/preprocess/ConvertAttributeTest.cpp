@@ -243,14 +243,16 @@ TEST(ConvertAttribute, VersionThreeStoresAreReadAndAppendedToAsVersionThree) {
   EXPECT_EQ(range->min, std::min(back.frame(0)->stats.attributeMin, back.frame(3)->stats.attributeMin));
   EXPECT_EQ(range->max, std::max(back.frame(0)->stats.attributeMax, back.frame(3)->stats.attributeMax));
   EXPECT_EQ(storedValues(back, 3).size(), 40u);
-  // A version 3 frame file in a version 5 store is refused, naming both versions.
-  StoreHeader v5 = header;
-  v5.version = kStoreVersion;
+  // A version 3 frame file in a store of this version is refused, naming both versions.
+  StoreHeader current = header;
+  current.version = kStoreVersion;
   try {
-    readFrameIndex(back.framePath(0), v5);
+    readFrameIndex(back.framePath(0), current);
     FAIL();
   } catch (const FileError& e) {
-    EXPECT_NE(std::string(e.what()).find("unsupported frame version 3 (the store is version 5"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("unsupported frame version 3 (the store is version " +
+                                         std::to_string(kStoreVersion)),
+              std::string::npos)
         << e.what();
   }
 }

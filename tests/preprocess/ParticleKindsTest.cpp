@@ -145,8 +145,9 @@ TEST(StoreHeaderKinds, FlagRoundTripsAndIsChecked) {
   EXPECT_TRUE(parseStoreHeader(bytes, "store.fsh").particleKinds);
   h.particleKinds = false;
   EXPECT_FALSE(parseStoreHeader(serializeStoreHeader(h), "store.fsh").particleKinds);
-  // The flag is the 4 bytes before the run count and the checksum: 2 is refused, naming it.
-  const std::size_t flag = bytes.size() - 8 - 4 - 4;
+  // The flag is the 4 bytes before the up axis, the run count and the checksum: 2 is refused,
+  // naming it.
+  const std::size_t flag = bytes.size() - 8 - 4 - 4 - 4;
   bytes[flag] = std::byte{2};
   const std::uint64_t sum = checksum64(std::span<const std::byte>(bytes).first(bytes.size() - 8));
   std::memcpy(bytes.data() + bytes.size() - 8, &sum, 8);

@@ -156,7 +156,8 @@ TEST(StoreHeaderV3, VersionTwoStoresAndFramesAreRefusedAskingToConvertAgain) {
   ASSERT_EQ(w.size(), 80u);
   expectFileError(
       [&] { parseStoreHeader(w.view(), "old/store.fsh"); },
-      {"old/store.fsh", "unsupported store version 2", "reads versions 3 to 5", "convert the particle files again"});
+      {"old/store.fsh", "unsupported store version 2", "reads versions 3 to " + std::to_string(kStoreVersion),
+       "convert the particle files again"});
 
   // A version 2 frame file (88-byte footer, version 24 bytes before the end) is named as one.
   testing::TempDir temp("v2-frame");

@@ -71,7 +71,7 @@ TEST_F(Cli, DefaultConvertOfMantaflowMakesOneCellPerParticleSpacingAndInfoShowsI
   EXPECT_LT(spacing, 0.05);
   EXPECT_EQ(spacing, j["cell_size"].get<double>());
   EXPECT_DOUBLE_EQ(j["particle_spacing_cells"].get<double>(), 1.0);
-  EXPECT_EQ(j["version"].get<std::uint32_t>(), 5u);
+  EXPECT_EQ(j["version"].get<std::uint32_t>(), 6u);
   EXPECT_EQ(j["particle_kinds"], false) << "a FLIP file alone";
 
   CommandRun text = run("info " + path("store"));
@@ -85,6 +85,42 @@ TEST_F(Cli, DefaultConvertOfMantaflowMakesOneCellPerParticleSpacingAndInfoShowsI
   EXPECT_EQ(coarse["cell_size"].get<double>(), 0.1);
   EXPECT_EQ(coarse["particle_spacing"].get<double>(), spacing);
   EXPECT_NEAR(coarse["particle_spacing_cells"].get<double>(), spacing / 0.1, 1e-12);
+}
+
+TEST_F(Cli, TheStoresUpAxisOrientsRenderUnlessGivenUp) {
+  const fs::path vdb = fs::path(FLIPSCOPE_DATA_DIR) / "mantaflow-dam64" / "data" / "fluid_data_0030.vdb";
+  CommandRun inspect = run("inspect '" + vdb.string() + "'");
+  ASSERT_EQ(inspect.exitCode, 0) << inspect.output;
+  EXPECT_NE(inspect.output.find("up axis     z (the file's conventions"), std::string::npos) << inspect.output;
+  CommandRun convert = run("convert '" + vdb.string() + "' -o " + path("store"));
+  ASSERT_EQ(convert.exitCode, 0) << convert.output;
+  EXPECT_NE(convert.output.find("up axis z (the conventions of"), std::string::npos) << convert.output;
+  EXPECT_EQ(nlohmann::json::parse(run("info --json " + path("store")).output)["up_axis"], "z");
+  EXPECT_NE(run("info " + path("store")).output.find("up axis    z"), std::string::npos);
+
+  const auto cameraUp = [&](const std::string& options) {
+    CommandRun render = run("render " + path("store") + " -o " + path("a.png") + " --size 64x36 -q --save-camera " +
+                            path("cam.json") + " " + options);
+    EXPECT_EQ(render.exitCode, 0) << render.output;
+    std::ifstream in(path("cam.json"));
+    return nlohmann::json::parse(in)["up"];
+  };
+  EXPECT_EQ(cameraUp(""), nlohmann::json::array({0.0, 0.0, 1.0})) << "the store's";
+  EXPECT_EQ(cameraUp("--up auto"), nlohmann::json::array({0.0, 0.0, 1.0}));
+  EXPECT_EQ(cameraUp("--up y"), nlohmann::json::array({0.0, 1.0, 0.0})) << "--up wins";
+
+  CommandRun bad = run("convert '" + vdb.string() + "' -o " + path("other") + " --up w");
+  EXPECT_EQ(bad.exitCode, 2) << bad.output;
+  EXPECT_NE(bad.output.find("--up: expected auto, x, y or z, got 'w'"), std::string::npos) << bad.output;
+  // A store of files that say nothing records nothing, and renders take y.
+  ASSERT_EQ(run("synth -o " + path("s.ply") + " --particles 2k").exitCode, 0);
+  ASSERT_EQ(run("convert " + path("s.ply") + " -o " + path("plain") + " -q").exitCode, 0);
+  EXPECT_TRUE(nlohmann::json::parse(run("info --json " + path("plain")).output)["up_axis"].is_null());
+  CommandRun plain = run("render " + path("plain") + " -o " + path("p.png") + " --size 64x36 -q --save-camera " +
+                         path("cam.json"));
+  ASSERT_EQ(plain.exitCode, 0) << plain.output;
+  std::ifstream in(path("cam.json"));
+  EXPECT_EQ(nlohmann::json::parse(in)["up"], nlohmann::json::array({0.0, 1.0, 0.0}));
 }
 
 TEST_F(Cli, DamagedStoreFailsVerifyNamingFileAndBrick) {

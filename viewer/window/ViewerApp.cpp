@@ -181,8 +181,8 @@ bool ViewerApp::pollSource() {
     const Camera home =
         mOptions.camera ? *mOptions.camera
                         : defaultRenderCamera(*mSource, mTimeline->frame(), mTimeline->frame(), size.x, size.y,
-                                              mOptions.request.up);
-    mNavigation.emplace(home, mOptions.request.up);
+                                              resolved.surface.up);
+    mNavigation.emplace(home, resolved.surface.up);
   } else if (frames != mTimeline->frames()) {
     mTimeline->setFrames(frames);
   }

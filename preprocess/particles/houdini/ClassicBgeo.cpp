@@ -166,6 +166,8 @@ class ClassicBgeoReader final : public ParticleSource {
   std::string format() const override {
     return "Houdini classic binary geometry (BgeoV version " + std::to_string(kVersion) + ")";
   }
+  /// Houdini's world is +y up.
+  UpAxis upAxis() const override { return UpAxis::Y; }
   std::vector<AttributeDesc> attributes() const override { return mPlan.exposed; }
   bool hasVelocity() const override { return mHasVelocity; }
   std::optional<std::uint64_t> countHint() const override { return std::uint64_t(mHeader.points); }

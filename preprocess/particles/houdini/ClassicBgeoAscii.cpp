@@ -63,6 +63,8 @@ class ClassicGeoReader final : public ParticleSource {
 
   std::string name() const override { return mFile.path().string(); }
   std::string format() const override { return "Houdini classic ASCII geometry (PGEOMETRY V5)"; }
+  /// Houdini's world is +y up.
+  UpAxis upAxis() const override { return UpAxis::Y; }
   std::vector<AttributeDesc> attributes() const override { return mPlan.exposed; }
   bool hasVelocity() const override { return mHasVelocity; }
   std::optional<std::uint64_t> countHint() const override { return mCounts[0]; }

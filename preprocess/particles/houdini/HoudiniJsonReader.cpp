@@ -106,6 +106,8 @@ class HoudiniJsonReader final : public ParticleSource {
                                                          : "Houdini ASCII JSON geometry (.geo)") +
            ", Houdini " + (mLayout.fileVersion.empty() ? std::string("(no fileversion)") : mLayout.fileVersion);
   }
+  /// Houdini's world is +y up.
+  UpAxis upAxis() const override { return UpAxis::Y; }
   std::vector<AttributeDesc> attributes() const override { return mAttributes; }
   bool hasVelocity() const override { return mVelocity.has_value(); }
   std::optional<std::uint64_t> countHint() const override { return mLayout.pointCount; }
