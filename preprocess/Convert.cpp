@@ -24,6 +24,7 @@
 #include "preprocess/store/FrameFile.h"
 #include "preprocess/store/StoreLock.h"
 #include "preprocess/ParticleSpacing.h"
+#include "preprocess/particles/PrefetchingSource.h"
 
 namespace flipscope {
 namespace {
@@ -423,10 +424,18 @@ std::string inputFileNames(const std::vector<FrameInput>& inputs) {
   return names;
 }
 
-Box scanBounds(ParticleSource& source, std::size_t chunkParticles, Progress* progress) {
+/// `source`, or a PrefetchingSource over it in `ahead` with `readAhead`.
+ParticleSource& readingAhead(ParticleSource& source, bool readAhead, std::optional<PrefetchingSource>& ahead) {
+  if (!readAhead) return source;
+  return ahead.emplace(source);
+}
+
+Box scanBounds(ParticleSource& source, std::size_t chunkParticles, bool readAhead, Progress* progress) {
   Box bounds;
   ParticleChunk chunk;
-  while (source.read(chunk, chunkParticles)) {
+  std::optional<PrefetchingSource> ahead;
+  ParticleSource& input = readingAhead(source, readAhead, ahead);
+  while (input.read(chunk, chunkParticles)) {
     bounds.extend(tbb::parallel_reduce(
         tbb::blocked_range<std::size_t>(0, chunk.size(), 1 << 15), Box{},
         [&](const auto& range, Box b) {
@@ -452,15 +461,47 @@ std::string formatNumber(double v) {
   return text;
 }
 
+/// What a pass over the positions alone reads: no velocities, no attributes.
+ReadOptions positionsOnly(ReadOptions read) {
+  read.velocity = false;
+  read.attributes.clear();
+  read.allAttributes = false;
+  return read;
+}
+
+/// scanInputBounds(), but frame i's bounds are known[i] where it holds them (not read again).
+Box scanInputBounds(const std::vector<FrameInput>& inputs, const ConvertOptions& options, std::uint64_t particles,
+                    const std::vector<std::optional<Box>>& known) {
+  const ReadOptions read = positionsOnly(options.read);
+  Progress progress("scan bounds", particles, "particles", options.progress);
+  const MemoryPlan plan(options.memoryBudget, false);
+  Box bounds;
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    if (i < known.size() && known[i]) {
+      bounds.extend(*known[i]);
+      continue;
+    }
+    bounds.extend(scanBounds(*openFrame(inputs[i], read), plan.chunkParticles, options.readAhead, &progress));
+  }
+  progress.finish();
+  return bounds;
+}
+
 /// The particle spacing of the first frame; of the next ones (up to 4 frames) while unknown.
-SpacingEstimate measureSpacing(const std::vector<FrameInput>& inputs, const ConvertOptions& options) {
+/// `bounds[i]`: the bounds of frame i when measuring it read all of it (SpacingEstimate::bounds).
+SpacingEstimate measureSpacing(const std::vector<FrameInput>& inputs, const ConvertOptions& options,
+                               std::vector<std::optional<Box>>& bounds) {
+  bounds.assign(inputs.size(), std::nullopt);
   SpacingEstimate estimate;
   for (std::size_t i = 0; i < std::min<std::size_t>(inputs.size(), 4); ++i) {
-    auto source = openFrame(inputs[i], options.read);
+    auto source = openFrame(inputs[i], positionsOnly(options.read));
     const std::string frame = "frame " + std::to_string(inputs[i].frame);
     std::optional<Progress> progress;  // the metadata estimate reads nothing
     if (!source->spacingHint()) progress.emplace("particle spacing of " + frame, 0, "particles", options.progress);
-    estimate = estimateParticleSpacing(*source, progress ? &*progress : nullptr);
+    std::optional<PrefetchingSource> ahead;
+    estimate = estimateParticleSpacing(readingAhead(*source, options.readAhead, ahead),
+                                       progress ? &*progress : nullptr);
+    bounds[i] = estimate.bounds;
     if (progress) progress->finish();
     estimate.origin = frame + ": " + estimate.origin;
     if (estimate.known()) break;
@@ -685,16 +726,7 @@ StaleFiles removeStaleFiles(const std::filesystem::path& dir, bool temporaries) 
 }
 
 Box scanInputBounds(const std::vector<FrameInput>& inputs, const ConvertOptions& options, std::uint64_t particles) {
-  ReadOptions read = options.read;
-  read.velocity = false;
-  read.attributes.clear();
-  read.allAttributes = false;
-  Progress progress("scan bounds", particles, "particles", options.progress);
-  const MemoryPlan plan(options.memoryBudget, false);
-  Box bounds;
-  for (const auto& input : inputs) bounds.extend(scanBounds(*openFrame(input, read), plan.chunkParticles, &progress));
-  progress.finish();
-  return bounds;
+  return scanInputBounds(inputs, options, particles, {});
 }
 
 StoreHeader makeStoreHeader(const Box& bounds, const ConvertOptions& options, AttributeKind attribute,
@@ -758,7 +790,9 @@ FrameReport convertOneFrame(ParticleSource& source, BrickStore& store, int frame
 
   FrameBinner binner(grid, kind, plan, options, scratch, frame);
   ParticleChunk chunk;
-  while (source.read(chunk, plan.chunkParticles)) {
+  std::optional<PrefetchingSource> ahead;  // the next chunk is read while this one is binned
+  ParticleSource& input = readingAhead(source, options.readAhead, ahead);
+  while (input.read(chunk, plan.chunkParticles)) {
     const std::size_t storedColumns = kind == AttributeKind::Scalar || kind == AttributeKind::Magnitude ? 1 : 0;
     if (header.particleKinds && (chunk.attributes.size() != storedColumns + 1 || chunk.attributes.back().arity != 1))
       throw FileError(source.name(), "was read without the column of particle types that the store keeps");
@@ -958,19 +992,20 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
     reading.read.attributes = {attribute.name};
   if (!keepHeader) {
     SpacingEstimate spacing;
+    std::vector<std::optional<Box>> measuredBounds;  // of the frames the spacing estimate read whole
     if (options.particleSpacing) {
       spacing.spacing = *options.particleSpacing;
       spacing.origin = spacing.spacing > 0 ? "given" : "not measured";
       if (!(std::isfinite(spacing.spacing) && spacing.spacing >= 0))
         throw InputError("particle spacing must be a positive number or 0");
     } else {
-      spacing = measureSpacing(inputs, reading);
+      spacing = measureSpacing(inputs, reading, measuredBounds);
     }
     Box bounds;
     if (options.domain) {
       bounds = *options.domain;
     } else {
-      bounds = scanInputBounds(inputs, reading, hinted);
+      bounds = scanInputBounds(inputs, reading, hinted, measuredBounds);
       if (bounds.isEmpty())
         throw InputError(inputFileNames(inputs) +
                          ": no finite particle positions (no particles, or only NaN/Inf ones): cannot derive a "

@@ -98,6 +98,10 @@ struct ConvertOptions {
   /// store's; another axis asked for is refused.
   std::optional<UpAxis> upAxis;
   int zstdLevel = 1;
+  /// Read the next chunk of particles on a thread of its own while this one is binned (and
+  /// while the bounds and the spacing passes work on it): PrefetchingSource. Off: one thread
+  /// reads and bins in turn. The store is the same either way.
+  bool readAhead = true;
   std::filesystem::path scratchDir;    ///< spill files; default: the store directory
   /// Add to the store at storeDir, which must exist, with its header: also a store with no
   /// frames yet (made by prepareOnly), which is otherwise started anew. What farm tasks do.

@@ -17,6 +17,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <glm/common.hpp>
+#include <glm/vector_relational.hpp>
 #include <glm/vec3.hpp>
 
 #include "core/Error.h"
@@ -26,6 +27,8 @@ namespace {
 
 constexpr std::size_t kChunkParticles = 1 << 16;
 constexpr std::size_t kNeighbours = kSpacingNeighbour;
+/// Query grids of at most this many cells are indexed directly (16 MiB), larger ones hashed.
+constexpr std::size_t kDenseCells = std::size_t(1) << 22;
 
 /// Spacing per k-th neighbour distance r: at spacing r * ballFactor(), a ball of radius r holds k particles.
 double ballFactor() { return std::cbrt(4 * std::numbers::pi / (3 * double(kSpacingNeighbour))); }
@@ -43,6 +46,7 @@ struct Sample {
   std::vector<glm::vec3> positions;
   std::vector<std::uint64_t> ids;  ///< index of each sampled particle in the source's order
   std::uint64_t finite = 0;        ///< finite particles in the whole source
+  Box bounds;                      ///< of the finite particles of the whole source
   bool complete() const { return finite == positions.size(); }
 };
 
@@ -56,6 +60,7 @@ Sample reservoirSample(ParticleSource& source, std::size_t size, Progress* progr
     for (const glm::vec3& p : chunk.positions) {
       if (isFinite(p)) {
         ++s.finite;
+        s.bounds.extend(glm::dvec3(p));
         if (s.positions.size() < size) {
           s.positions.push_back(p);
           s.ids.push_back(id);
@@ -74,9 +79,10 @@ Sample reservoirSample(ParticleSource& source, std::size_t size, Progress* progr
 }
 
 /// The k-th neighbour distance of every query among the candidates given to add(), searched as
-/// far as `radius`: a query whose k-th neighbour is farther keeps +inf. Queries are hashed into
-/// cells of 2 * radius, so a candidate only visits the 8 cells on its side of its own cell; a
-/// candidate with the id of a query is that query itself and skipped.
+/// far as `radius`: a query whose k-th neighbour is farther keeps +inf. Queries are binned into
+/// cells of 2 * radius (indexed directly, or hashed when the grid is large), so a candidate only
+/// visits the 8 cells on its side of its own cell; a candidate with the id of a query is that
+/// query itself and skipped.
 class KthNeighbours {
  public:
   KthNeighbours(const Sample& queries, double radius)
@@ -150,6 +156,30 @@ class KthNeighbours {
       return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
     };
     std::sort(mOrder.begin(), mOrder.end(), [&](std::uint32_t a, std::uint32_t b) { return less(cells[a], cells[b]); });
+    // Small grids (the usual case) index their cells directly: mOrder is sorted in the order of
+    // the dense index (x, then y, then z), so each cell's queries are one range of it.
+    glm::i64vec3 dims(1);
+    for (const glm::ivec3& c : cells) dims = glm::max(dims, glm::i64vec3(c) + std::int64_t(1));
+    if (dims.x * dims.y * dims.z <= std::int64_t(kDenseCells)) {
+      mDims = glm::ivec3(dims);
+      mDenseStart.assign(std::size_t(dims.x * dims.y * dims.z) + 1, 0);
+      for (const glm::ivec3& c : cells) ++mDenseStart[denseIndex(c) + 1];
+      for (std::size_t i = 1; i < mDenseStart.size(); ++i) mDenseStart[i] += mDenseStart[i - 1];
+      // Bit o of a cell's mask: a query lies in the 2x2x2 cells a candidate of the cell visits
+      // when it is in octant o (visit()); over the grid and one cell around it.
+      mBlockMask.assign(std::size_t(dims.x + 2) * std::size_t(dims.y + 2) * std::size_t(dims.z + 2), 0);
+      for (std::size_t i = 0; i < n; ++i) {
+        if (i > 0 && cells[mOrder[i]] == cells[mOrder[i - 1]]) continue;
+        const glm::ivec3 q = cells[mOrder[i]];
+        for (int octant = 0; octant < 8; ++octant)
+          for (int corner = 0; corner < 8; ++corner) {
+            const glm::ivec3 step(corner & 1 ? octantSide(octant, 0) : 0, corner & 2 ? octantSide(octant, 1) : 0,
+                                  corner & 4 ? octantSide(octant, 2) : 0);
+            mBlockMask[maskIndex(q - step)] |= std::uint8_t(1u << octant);
+          }
+      }
+      return;
+    }
     std::size_t groups = 0;
     for (std::size_t i = 0; i < n; ++i) groups += i == 0 || cells[mOrder[i]] != cells[mOrder[i - 1]];
     mTable.assign(std::bit_ceil(std::max<std::size_t>(16, 2 * groups)), Slot{});
@@ -164,11 +194,30 @@ class KthNeighbours {
     }
   }
 
-  const Slot* find(const glm::ivec3& cell) const {
+  /// The side (-1 or 1) of `axis` of octant o: bit `axis` of o set is the upper half.
+  static int octantSide(int octant, int axis) { return octant >> axis & 1 ? 1 : -1; }
+  /// Index into mBlockMask of a cell in [-1, mDims] on every axis.
+  std::size_t maskIndex(const glm::ivec3& c) const {
+    return (std::size_t(c.x + 1) * std::size_t(mDims.y + 2) + std::size_t(c.y + 1)) * std::size_t(mDims.z + 2) +
+           std::size_t(c.z + 1);
+  }
+
+  std::size_t denseIndex(const glm::ivec3& c) const {
+    return (std::size_t(c.x) * std::size_t(mDims.y) + std::size_t(c.y)) * std::size_t(mDims.z) + std::size_t(c.z);
+  }
+
+  /// The queries of `cell`: mOrder[begin, end), empty when it has none.
+  std::pair<std::uint32_t, std::uint32_t> find(const glm::ivec3& cell) const {
+    if (!mDenseStart.empty()) {
+      if (cell.x < 0 || cell.y < 0 || cell.z < 0 || cell.x >= mDims.x || cell.y >= mDims.y || cell.z >= mDims.z)
+        return {0, 0};
+      const std::size_t i = denseIndex(cell);
+      return {mDenseStart[i], mDenseStart[i + 1]};
+    }
     for (std::size_t s = hash(cell) & mMask;; s = (s + 1) & mMask) {
       const Slot& slot = mTable[s];
-      if (slot.begin == slot.end) return nullptr;
-      if (slot.cell == cell) return &slot;
+      if (slot.begin == slot.end) return {0, 0};
+      if (slot.cell == cell) return {slot.begin, slot.end};
     }
   }
 
@@ -211,12 +260,16 @@ class KthNeighbours {
     // A query within radius = half a cell lies in this cell or the neighbour on the side of
     // the half the candidate is in, on every axis.
     const glm::ivec3 side(f.x - base.x < 0.5 ? -1 : 1, f.y - base.y < 0.5 ? -1 : 1, f.z - base.z < 0.5 ? -1 : 1);
+    if (!mBlockMask.empty()) {  // most candidates have no query near: one byte says so
+      if (glm::any(glm::lessThan(cell, glm::ivec3(-1))) || glm::any(glm::greaterThan(cell, mDims))) return;
+      const int octant = (side.x > 0 ? 1 : 0) | (side.y > 0 ? 2 : 0) | (side.z > 0 ? 4 : 0);
+      if (!(mBlockMask[maskIndex(cell)] >> octant & 1)) return;
+    }
     const float radius2 = float(mRadius * mRadius);
     for (int corner = 0; corner < 8; ++corner) {
       const glm::ivec3 c = cell + glm::ivec3(corner & 1 ? side.x : 0, corner & 2 ? side.y : 0, corner & 4 ? side.z : 0);
-      const Slot* slot = find(c);
-      if (!slot) continue;
-      for (std::uint32_t i = slot->begin; i < slot->end; ++i) {
+      const auto [begin, end] = find(c);
+      for (std::uint32_t i = begin; i < end; ++i) {
         const std::uint32_t j = mOrder[i];
         if (mQueries.ids[j] == id) continue;
         const glm::vec3 d = mQueries.positions[j] - candidate;
@@ -231,7 +284,10 @@ class KthNeighbours {
   glm::dvec3 mOrigin{0}, mLo{0}, mHi{0};
   bool mUsable = false;
   std::vector<std::uint32_t> mOrder;
-  std::vector<Slot> mTable;
+  glm::ivec3 mDims{0};                     ///< of the dense index, when mDenseStart is not empty
+  std::vector<std::uint32_t> mDenseStart;  ///< per dense cell, its first query in mOrder; then n
+  std::vector<std::uint8_t> mBlockMask;    ///< with the dense index: see buildTable()
+  std::vector<Slot> mTable;                ///< else: the cells with queries, hashed
   std::size_t mMask = 0;
   std::vector<float> mHeaps;  ///< k squared distances per query, a max-heap each
   tbb::enumerable_thread_specific<std::vector<Hit>> mHits;
@@ -290,6 +346,7 @@ SpacingEstimate neighbourSpacing(ParticleSource& source, std::size_t sampleSize,
   sampleSize = std::max(sampleSize, kNeighbours + 1);
   const Sample sample = reservoirSample(source, sampleSize, progress);
   SpacingEstimate e;
+  e.bounds = sample.bounds;
   if (sample.finite < kNeighbours + 1) {
     e.origin = "too few particles to measure (" + std::to_string(sample.finite) + " finite)";
     return e;

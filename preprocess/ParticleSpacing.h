@@ -26,11 +26,13 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <span>
 #include <string>
 
 #include <glm/vec3.hpp>
 
+#include "core/Box.h"
 #include "core/Progress.h"
 #include "preprocess/particles/ParticleSource.h"
 
@@ -43,6 +45,9 @@ inline constexpr int kSpacingMaxPasses = 6;
 struct SpacingEstimate {
   double spacing = 0;  ///< world units; 0 = unknown
   std::string origin;  ///< how it was found, for messages (or why it is unknown)
+  /// The bounds of the source's finite particles when the estimate read every particle (the
+  /// neighbour estimate's sampling pass), so that convert need not read them again; else nullopt.
+  std::optional<Box> bounds;
   bool known() const { return spacing > 0; }
 };
 

@@ -150,8 +150,9 @@ TEST(Convert, AttributeQuantizationByHand) {
   EXPECT_EQ(detail::quantizeAttribute(5.0f, 5.0f, 5.0f), 0);      // an empty range
 }
 
-TEST(Convert, OutOfCoreStoreIsByteIdenticalToInCore) {
-  // ~1.5 M particles (18 MB of float32, 30 MB with velocities) against a 4 MiB budget.
+TEST(Convert, OutOfCoreStoreIsByteIdenticalToInCoreWithAndWithoutReadAhead) {
+  // ~1.5 M particles (18 MB of float32, 30 MB with velocities) against a 4 MiB budget. Neither
+  // budget's chunk (174762 and 4096 particles) divides the count.
   auto positions = testing::randomParticles(1500000, 77, 50.0f);
   std::vector<glm::vec3> velocities(positions.size());
   for (std::size_t i = 0; i < positions.size(); ++i) velocities[i] = glm::vec3(std::sin(float(i)), 0.5f, 0);
@@ -160,8 +161,9 @@ TEST(Convert, OutOfCoreStoreIsByteIdenticalToInCore) {
   options.progress = Progress::Mode::Silent;
   const Box domain{{0, 0, 0}, {50, 50, 50}};
   testing::TempDir temp("out-of-core");
-  auto run = [&](std::uint64_t budget, const std::string& name) {
+  auto run = [&](std::uint64_t budget, const std::string& name, bool readAhead = true) {
     options.memoryBudget = budget;
+    options.readAhead = readAhead;
     const fs::path dir = temp / name;
     StoreHeader header = makeStoreHeader(domain, options, AttributeKind::Speed);
     header.id = {7, 7, 7};  // the same id for both stores: then the files are the same bytes
@@ -176,6 +178,13 @@ TEST(Convert, OutOfCoreStoreIsByteIdenticalToInCore) {
   EXPECT_GT(outReport.spillBuckets, 1u);
   EXPECT_EQ(readFile(inCore / "frame_000001.fsf"), readFile(outOfCore / "frame_000001.fsf"));
   EXPECT_EQ(readFile(inCore / "store.fsh"), readFile(outOfCore / "store.fsh"));
+  // Reading the next chunk on a thread of its own (the default) writes what reading and binning
+  // in turn does, in core and out of core.
+  for (const auto& [budget, name] : {std::pair(1ull << 30, "incore-in-turn"), std::pair(4ull << 20, "ooc-in-turn")}) {
+    const auto [dir, report] = run(budget, name, false);
+    EXPECT_EQ(report.spillBuckets > 0, budget < (1ull << 30)) << name;
+    EXPECT_EQ(readFile(dir / "frame_000001.fsf"), readFile(inCore / "frame_000001.fsf")) << name;
+  }
   // No spill file is left behind.
   for (const auto& e : fs::directory_iterator(outOfCore))
     EXPECT_TRUE(e.path().filename() == "store.fsh" || e.path().filename() == "store.lock" ||
