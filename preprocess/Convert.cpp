@@ -473,17 +473,18 @@ ReadOptions positionsOnly(ReadOptions read) {
 Box scanInputBounds(const std::vector<FrameInput>& inputs, const ConvertOptions& options, std::uint64_t particles,
                     const std::vector<std::optional<Box>>& known) {
   const ReadOptions read = positionsOnly(options.read);
-  Progress progress("scan bounds", particles, "particles", options.progress);
   const MemoryPlan plan(options.memoryBudget, false);
   Box bounds;
+  std::optional<Progress> progress;  // none when every frame's bounds are known
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     if (i < known.size() && known[i]) {
       bounds.extend(*known[i]);
       continue;
     }
-    bounds.extend(scanBounds(*openFrame(inputs[i], read), plan.chunkParticles, options.readAhead, &progress));
+    if (!progress) progress.emplace("scan bounds", particles, "particles", options.progress);
+    bounds.extend(scanBounds(*openFrame(inputs[i], read), plan.chunkParticles, options.readAhead, &*progress));
   }
-  progress.finish();
+  if (progress) progress->finish();
   return bounds;
 }
 

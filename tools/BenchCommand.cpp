@@ -13,6 +13,7 @@ void addBenchCommand(CLI::App& app) {
   addBenchSurfaceCommand(*bench);
   addBenchFarmCommand(*bench);
   addBenchViewCommand(*bench);
+  addBenchScaleCommand(*bench);
 }
 
 }  // namespace flipscope::tools

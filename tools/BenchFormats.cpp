@@ -1,21 +1,15 @@
 #include "tools/BenchFormats.h"
 
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <chrono>
 #include <cstdio>
 
 #include "core/Error.h"
 #include "core/Progress.h"
+#include "tools/ChildProcess.h"
 #include "tools/CliValues.h"
 #include "preprocess/SynthFluid.h"
 #include "preprocess/particles/ParticleSource.h"
 #include "preprocess/particles/ParticleWriter.h"
-
-extern char** environ;
 
 namespace flipscope::tools {
 namespace {
@@ -68,42 +62,6 @@ ReadTiming timeRead(const fs::path& path) {
   return best;
 }
 
-struct ChildRun {
-  int exitCode = -1;
-  double peakMiB = 0;  ///< as the child reports it ("peak memory N MiB"), 0 if it did not
-  double seconds = 0;
-};
-
-/// Runs this binary with `arguments`, its output into `log`, and reads the peak memory it reports.
-ChildRun runChild(const std::vector<std::string>& arguments, const fs::path& log) {
-  std::vector<std::string> strings{"/proc/self/exe"};
-  strings.insert(strings.end(), arguments.begin(), arguments.end());
-  std::vector<char*> argv;
-  for (auto& s : strings) argv.push_back(s.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  pid_t pid = 0;
-  const auto start = std::chrono::steady_clock::now();
-  const int spawned = posix_spawn(&pid, "/proc/self/exe", &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  ChildRun run;
-  if (spawned != 0) return run;
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  run.seconds = secondsSince(start);
-  run.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  if (std::FILE* out = std::fopen(log.c_str(), "r")) {
-    char line[512];
-    while (std::fgets(line, sizeof line, out)) std::sscanf(line, "peak memory %lf MiB", &run.peakMiB);
-    std::fclose(out);
-  }
-  return run;
-}
-
 }  // namespace
 
 nlohmann::json benchFormats(const FormatBenchOptions& options) {
@@ -118,8 +76,8 @@ nlohmann::json benchFormats(const FormatBenchOptions& options) {
     const ReadTiming read = timeRead(file);
     const fs::path store = options.workDir / ("store-" + format);
     fs::remove_all(store);
-    const ChildRun convert = runChild({"convert", file.string(), "-o", store.string(), "--mem", options.mem},
-                                      options.workDir / ("convert-" + format + ".log"));
+    const ChildRun convert = runFlipscopeChild({"convert", file.string(), "-o", store.string(), "--mem", options.mem},
+                                               options.workDir / ("convert-" + format + ".log"));
     fs::remove_all(store);
     const double rate = double(read.particles) / read.seconds;
     rows.push_back({{"format", format},
@@ -131,7 +89,7 @@ nlohmann::json benchFormats(const FormatBenchOptions& options) {
                     {"ratio_to_raw_float_read", rate / rawRate},
                     {"convert_exit_code", convert.exitCode},
                     {"convert_s", convert.seconds},
-                    {"convert_peak_rss_mib", convert.peakMiB}});
+                    {"convert_peak_rss_mib", convert.reportedPeakMiB}});
   }
   return {{"raw_float_read_particles_per_s", rawRate},
           {"raw_float_read_s", rawRead.seconds},

@@ -42,5 +42,6 @@ void addBenchRenderCommand(CLI::App& bench);
 void addBenchSurfaceCommand(CLI::App& bench);
 void addBenchFarmCommand(CLI::App& bench);
 void addBenchViewCommand(CLI::App& bench);
+void addBenchScaleCommand(CLI::App& bench);
 
 }  // namespace flipscope::tools
