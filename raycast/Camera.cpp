@@ -39,6 +39,15 @@ void validate(const Camera& camera, const std::string& what) {
     throw InputError(what + ": field of view must be in (0, 180) degrees, got " + std::to_string(camera.fovYDegrees));
 }
 
+Camera orbitAbout(const Camera& camera, glm::dvec3 axis, double degrees) {
+  const double a = glm::radians(degrees);
+  const glm::dvec3 k = glm::normalize(axis), v = camera.eye - camera.target;
+  Camera c = camera;
+  // Rodrigues' rotation of the eye's offset from the target.
+  c.eye = camera.target + v * std::cos(a) + glm::cross(k, v) * std::sin(a) + k * glm::dot(k, v) * (1 - std::cos(a));
+  return c;
+}
+
 Camera frameOnBox(const Box& box, double aspect, glm::dvec3 up, double fovYDegrees) {
   FLIPSCOPE_CHECK(!box.isEmpty() && aspect > 0);
   up = glm::normalize(up);

@@ -38,6 +38,10 @@ void validate(const Camera& camera, const std::string& what);
 /// whole box (all eight corners) fits into an image of `aspect` = width / height, with a margin.
 Camera frameOnBox(const Box& box, double aspect, glm::dvec3 up = {0, 1, 0}, double fovYDegrees = 40);
 
+/// `camera` with its eye turned by `degrees` (right-handed) about the line through its target
+/// along `axis`: a step of an orbit. Target, up and field of view are kept.
+Camera orbitAbout(const Camera& camera, glm::dvec3 axis, double degrees);
+
 /// Parses "ex,ey,ez,tx,ty,tz,ux,uy,uz,fov" (10 numbers, fov in degrees). Throws InputError
 /// naming `option`.
 Camera parseCamera(const std::string& option, const std::string& text);

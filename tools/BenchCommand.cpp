@@ -1,5 +1,6 @@
 #include <CLI/CLI.hpp>
 
+#include "tools/BenchFrameStage.h"
 #include "tools/Commands.h"
 
 namespace flipscope::tools {
@@ -14,6 +15,7 @@ void addBenchCommand(CLI::App& app) {
   addBenchFarmCommand(*bench);
   addBenchViewCommand(*bench);
   addBenchScaleCommand(*bench);
+  addBenchFrameStageCommand(*bench);
 }
 
 }  // namespace flipscope::tools

@@ -136,11 +136,7 @@ void runBenchRender(const BenchRenderArgs& a) {
     double frameMs = 0, traceMs = 0;
     int warmPasses = 0;
     for (int i = 0; i < a.orbitFrames; ++i) {
-      Camera orbit = camera;
-      const double angle = glm::radians(2.0 * (i + 1));
-      const glm::dvec3 offset = camera.eye - camera.target;
-      orbit.eye = camera.target + glm::dvec3(offset.x * std::cos(angle) - offset.z * std::sin(angle), offset.y,
-                                             offset.x * std::sin(angle) + offset.z * std::cos(angle));
+      const Camera orbit = orbitAbout(camera, {0, 1, 0}, -2.0 * (i + 1));
       const auto t = Clock::now();
       const FrameOutput warm = pipeline.render(0, orbit);
       frameMs += secondsSince(t) * 1e3 / a.orbitFrames;

@@ -5,27 +5,20 @@
 //   synth    the frame as raw float32 (12 bytes a particle: 6 GB for 500 M);
 //   convert  out of core within --mem;
 //   render   the first image at --size on --device (the CPU by default), then a few warm
-//            frames of an orbit about the up axis (the hidden `bench scale --render-stage`).
+//            frames of an orbit about the up axis (BenchFrameStage.h).
 // It prints each stage's time and peak RSS, the store's size and bits per particle, and the
 // bricks the first image touched against the bricks of the frame, beside the paper's figures.
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
-
-#include <glm/geometric.hpp>
 
 #include "core/AtomicFile.h"
 #include "core/Error.h"
-#include "core/ProcessMemory.h"
 #include "core/Progress.h"
-#include "pipeline/FramePipeline.h"
-#include "pipeline/RenderRequest.h"
-#include "raycast/ImageWriter.h"
+#include "preprocess/store/BrickStore.h"
+#include "tools/BenchFrameStage.h"
 #include "tools/ChildProcess.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
@@ -35,7 +28,6 @@ namespace flipscope::tools {
 namespace {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
 
 struct BenchScaleArgs {
   std::string particles = "500M";
@@ -45,56 +37,7 @@ struct BenchScaleArgs {
   std::string device = "cpu";
   std::string workDir;
   bool json = false;
-  // The render stage (run by the bench in a child process).
-  std::string renderStage;  ///< the store to render; set: this process is the render stage
-  std::string statsFile;
 };
-
-double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-/// `camera` turned by `degrees` about the axis `up` through its target.
-Camera orbited(const Camera& camera, glm::dvec3 up, double degrees) {
-  const double a = glm::radians(degrees);
-  const glm::dvec3 k = glm::normalize(up), v = camera.eye - camera.target;
-  Camera c = camera;
-  c.eye = camera.target + v * std::cos(a) + glm::cross(k, v) * std::sin(a) + k * glm::dot(k, v) * (1 - std::cos(a));
-  return c;
-}
-
-/// The render stage: the first image of frame 0 as `flipscope render` makes it (the store's
-/// defaults), then warm orbit frames; its figures as JSON into --stats-file.
-void runRenderStage(const BenchScaleArgs& a) {
-  const auto [width, height] = parseImageSize("--size", a.size);
-  const auto start = Clock::now();
-  BrickStore store = BrickStore::open(a.renderStage);
-  const std::vector<int> frames = store.frames();
-  if (frames.empty()) throw FileError(a.renderStage, "the store has no frame");
-  RenderRequest request;
-  request.settings.width = width;
-  request.settings.height = height;
-  const ResolvedRender look = resolve(request, store);
-  FramePipeline pipeline(std::move(store), parseDeviceChoice("--device", a.device), look.settings, look.surface);
-  const Camera camera =
-      defaultRenderCamera(pipeline.renderer().source(), frames.front(), frames.front(), width, height, look.surface.up);
-  const FrameOutput first = pipeline.render(frames.front(), camera);
-  const double firstSeconds = secondsSince(start);
-  writeImage((fs::path(a.statsFile).parent_path() / "scale_first.png").string(), first.image);
-  std::vector<double> warmMs;
-  for (int i = 1; i <= a.orbitFrames; ++i) {
-    const auto t = Clock::now();
-    pipeline.render(frames.front(), orbited(camera, look.surface.up, 2.0 * i));
-    warmMs.push_back(secondsSince(t) * 1e3);
-  }
-  const nlohmann::json j{{"device", pipeline.deviceName()},
-                         {"first_image_s", firstSeconds},
-                         {"first_trace_ms", first.stats.traceMs},
-                         {"first_passes", first.stats.passes},
-                         {"bricks_touched", first.stats.bricksUploaded},
-                         {"frame_bricks", first.stats.frameBricks},
-                         {"warm_frame_ms", warmMs},
-                         {"peak_rss_bytes", peakResidentBytes()}};
-  writeTextAtomically(a.statsFile, j.dump(2) + "\n");
-}
 
 std::uint64_t directoryBytes(const fs::path& dir) {
   std::uint64_t bytes = 0;
@@ -114,14 +57,13 @@ ChildRun runStage(const char* name, const std::vector<std::string>& arguments, c
 }
 
 void runBenchScale(const BenchScaleArgs& a) {
-  if (!a.renderStage.empty()) return runRenderStage(a);
   const std::uint64_t particles = parseCount("--particles", a.particles);
   const std::uint64_t mem = parseBytes("--mem", a.mem);
   (void)parseImageSize("--size", a.size);
   (void)parseDeviceChoice("--device", a.device);
   const fs::path work = a.workDir.empty() ? fs::temp_directory_path() / "flipscope-bench-scale" : fs::path(a.workDir);
   fs::create_directories(work);
-  const fs::path raw = work / "scale.bin", store = work / "scale.store", stats = work / "render.json";
+  const fs::path raw = work / "scale.bin", store = work / "scale.store";
 
   // synth: reused when the work directory holds the frame of this count (--work-dir).
   const fs::path marker = work / "scale.particles";
@@ -140,16 +82,13 @@ void runBenchScale(const BenchScaleArgs& a) {
   const std::uint64_t storeBytes = directoryBytes(store);
   const BrickStore opened = BrickStore::open(store);
   const std::uint64_t stored = opened.frame(opened.frames().front())->stats.particles;
-  const ChildRun render =
-      runStage("render",
-               {"bench", "scale", "--render-stage", store.string(), "--stats-file", stats.string(), "--size", a.size,
-                "--orbit-frames", std::to_string(a.orbitFrames), "--device", a.device},
-               work / "render.log", a.json);
-  std::ifstream in(stats);
-  const nlohmann::json r = nlohmann::json::parse(in);
-  std::vector<double> warm = r["warm_frame_ms"].get<std::vector<double>>();
-  double warmMean = 0;
-  for (double ms : warm) warmMean += ms / double(std::max<std::size_t>(warm.size(), 1));
+  if (!a.json) std::fprintf(stderr, "bench scale: render ...\n");
+  FrameStageRequest frame;
+  frame.store = store;
+  frame.size = a.size;
+  frame.orbitFrames = a.orbitFrames;
+  frame.device = a.device;
+  const FrameStageResult r = runFrameStage(frame, work, "scale_render");
   const double bitsPerParticle = stored ? 8.0 * double(storeBytes) / double(stored) : 0;
 
   if (a.json) {
@@ -163,18 +102,18 @@ void runBenchScale(const BenchScaleArgs& a) {
                {"convert_peak_rss_bytes", convert.peakBytes},
                {"store_bytes", storeBytes},
                {"store_bits_per_particle", bitsPerParticle},
-               {"render_device", r["device"]},
-               {"first_image_s", r["first_image_s"]},
-               {"render_peak_rss_bytes", render.peakBytes},
-               {"bricks_touched", r["bricks_touched"]},
-               {"frame_bricks", r["frame_bricks"]},
-               {"warm_frame_ms", warm}});
+               {"render_device", r.device},
+               {"first_image_s", r.firstImageSeconds},
+               {"render_peak_rss_bytes", r.peakBytes},
+               {"bricks_touched", r.bricksTouched},
+               {"frame_bricks", r.frameBricks},
+               {"warm_frame_ms", r.warmFrameMs}});
     return;
   }
   const auto gib = [](double bytes) { return bytes / double(1ull << 30); };
   std::printf("bench scale: %s particles in one frame (%s bytes raw float32), convert --mem %s, render %s on %s\n\n",
               Progress::humanCount(double(stored)).c_str(), Progress::humanCount(double(rawBytes)).c_str(),
-              a.mem.c_str(), a.size.c_str(), r["device"].get<std::string>().c_str());
+              a.mem.c_str(), a.size.c_str(), r.device.c_str());
   std::printf("%-40s %12s %14s   %s\n", "stage", "seconds", "peak RSS GiB", "paper (GTX Titan, 8 cores, SSD)");
   if (reused)
     std::printf("%-40s %12s %14s\n", "synth (reused from --work-dir)", "-", "-");
@@ -182,18 +121,17 @@ void runBenchScale(const BenchScaleArgs& a) {
     std::printf("%-40s %12.1f %14.2f\n", "synth (raw float32 written)", synth.seconds, gib(double(synth.peakBytes)));
   std::printf("%-40s %12.1f %14.2f   %s\n", ("convert --mem " + a.mem).c_str(), convert.seconds,
               gib(double(convert.peakBytes)), "12 s for 500 M");
-  std::printf("%-40s %12.2f %14.2f   %s\n", "render: first image (open to converged)", r["first_image_s"].get<double>(),
-              gib(double(render.peakBytes)), "under 1 s");
+  std::printf("%-40s %12.2f %14.2f   %s\n", "render: first image (open to converged)", r.firstImageSeconds,
+              gib(double(r.peakBytes)), "under 1 s");
   std::printf("%-40s %12.1f %14s   %s\n",
-              ("render: warm orbit frame, ms (mean of " + std::to_string(warm.size()) + ")").c_str(), warmMean, "",
-              "50-72 ms");
+              ("render: warm orbit frame, ms (mean of " + std::to_string(r.warmFrameMs.size()) + ")").c_str(),
+              r.warmMeanMs(), "", "50-72 ms");
   std::printf("\nstore: %s bytes, %.2f bits a particle; the first image touched %llu of the frame's %llu bricks\n",
-              Progress::humanCount(double(storeBytes)).c_str(), bitsPerParticle,
-              (unsigned long long)r["bricks_touched"].get<std::uint64_t>(),
-              (unsigned long long)r["frame_bricks"].get<std::uint64_t>());
+              Progress::humanCount(double(storeBytes)).c_str(), bitsPerParticle, (unsigned long long)r.bricksTouched,
+              (unsigned long long)r.frameBricks);
   std::printf("peak RSS against --mem %s: convert %.2f GiB; the particles alone would take %.1f GiB\n", a.mem.c_str(),
               gib(double(convert.peakBytes)), gib(double(rawBytes)));
-  std::printf("files in %s (the first image: scale_first.png; logs of each stage)\n", work.c_str());
+  std::printf("files in %s (the first image: scale_render.png; each stage's log)\n", work.c_str());
 }
 
 }  // namespace
@@ -210,8 +148,6 @@ void addBenchScaleCommand(CLI::App& bench) {
                   "Where the raw frame, the store and the logs go (default: a temp directory); a frame of the same "
                   "--particles there is reused");
   cmd->add_flag("--json", args->json, "Machine-readable output");
-  cmd->add_option("--render-stage", args->renderStage, "(internal) render this store as the render stage")->group("");
-  cmd->add_option("--stats-file", args->statsFile, "(internal) where the render stage writes its figures")->group("");
   cmd->callback([args] { runBenchScale(*args); });
 }
 

@@ -32,7 +32,7 @@ TEST(BenchScale, ReportsEveryStageOfASmallFrameAndReusesItsWorkDirectory) {
   EXPECT_LE(j["bricks_touched"].get<std::uint64_t>(), j["frame_bricks"].get<std::uint64_t>());
   EXPECT_EQ(j["warm_frame_ms"].size(), 2u);
   EXPECT_EQ(j["render_device"].get<std::string>().rfind("CPU", 0), 0u) << j["render_device"];
-  EXPECT_TRUE(std::filesystem::exists(dir / "scale_first.png"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "scale_render.png"));
 
   const flipscope::testing::CommandRun again = flipscope::testing::runFlipscope(command);
   ASSERT_EQ(again.exitCode, 0) << again.output;
