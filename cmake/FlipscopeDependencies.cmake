@@ -30,3 +30,12 @@ if(TARGET zstd::libzstd_shared)
 else()
   set(FLIPSCOPE_ZSTD zstd::libzstd_static)
 endif()
+
+# Optional: Embree 3, the peer of `bench render --peer embree` (Debian: libembree-dev). Only the
+# flipscope command links it; without it the bench says so.
+find_package(embree 3 QUIET)
+if(embree_FOUND)
+  message(STATUS "Embree ${embree_VERSION}: bench render --peer embree is built in")
+else()
+  message(STATUS "Embree 3 not found: bench render --peer embree will say so (Debian: libembree-dev)")
+endif()

@@ -2,6 +2,7 @@
 
 #include "tools/BenchFrameStage.h"
 #include "tools/Commands.h"
+#include "tools/EmbreePeer.h"
 
 namespace flipscope::tools {
 
@@ -16,6 +17,7 @@ void addBenchCommand(CLI::App& app) {
   addBenchViewCommand(*bench);
   addBenchScaleCommand(*bench);
   addBenchFrameStageCommand(*bench);
+  addBenchEmbreeStageCommand(*bench);
 }
 
 }  // namespace flipscope::tools

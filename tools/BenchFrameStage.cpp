@@ -57,7 +57,10 @@ void runStage(const FrameStageArgs& a) {
                                              : loadCamera(a.cameraFile);
   const FrameOutput first = pipeline.render(frames.front(), camera);
   const double firstSeconds = secondsSince(start);
-  if (!a.image.empty()) writeImage(a.image, first.image);
+  if (!a.image.empty()) {  // to look at, and with its depth (EXR) to compare
+    writeImage(a.image, first.image);
+    writeImage(fs::path(a.image).replace_extension(".exr"), first.image);
+  }
   nlohmann::json warm = nlohmann::json::array(), warmTrace = nlohmann::json::array();
   for (int i = 1; i <= a.request.orbitFrames; ++i) {
     const auto t = Clock::now();

@@ -38,8 +38,8 @@ struct FrameStageResult {
 };
 
 /// Runs the frame stage as a child (its output in `work`/`name`.log, its figures in
-/// `work`/`name`.json, its first image in `work`/`name`.png). Throws InputError naming the log
-/// when it fails.
+/// `work`/`name`.json, its first image in `work`/`name`.png and, with depth, `name`.exr).
+/// Throws InputError naming the log when it fails.
 FrameStageResult runFrameStage(const FrameStageRequest& request, const std::filesystem::path& work,
                                const std::string& name);
 

@@ -14,12 +14,15 @@
 #include <nlohmann/json.hpp>
 
 #include "core/Error.h"
+#include "tools/ChildProcess.h"
 #include "preprocess/Convert.h"
 #include "preprocess/particles/ParticleWriter.h"
 #include "preprocess/SynthFluid.h"
 #include "raycast/GpuRaycaster.h"
 #include "pipeline/FramePipeline.h"
 #include "tools/BenchFoam.h"
+#include "tools/BenchFrameStage.h"
+#include "tools/EmbreePeer.h"
 #include "tools/JsonOutput.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
@@ -40,6 +43,7 @@ struct BenchRenderArgs {
   std::string device = "auto";
   std::string gpuMem = "2G";
   bool skipVdbTool = false;
+  std::string peer;  ///< "embree": the same particles through Embree in the same run
   bool json = false;
 };
 
@@ -79,6 +83,93 @@ std::optional<double> timeVdbTool(const fs::path& ply, const fs::path& image, do
     return std::nullopt;
   }
   return seconds;
+}
+
+/// flipscope's convert and CPU ray-caster against Embree's sphere points, on the same particles
+/// with the same camera and sphere radius, each in a child process (its own peak RSS).
+struct PeerComparison {
+  std::string size;
+  double convertSeconds = 0;
+  std::uint64_t convertPeakBytes = 0;
+  FrameStageResult flipscope;
+  std::optional<EmbreeStageResult> embree;  ///< nullopt: not built in
+  float radiusWorld = 0;
+
+  double flipscopeFirst() const { return convertSeconds + flipscope.firstImageSeconds; }
+  nlohmann::json json() const {
+    nlohmann::json j{{"size", size},
+                     {"radius_world", radiusWorld},
+                     {"flipscope_convert_s", convertSeconds},
+                     {"flipscope_first_image_s", flipscope.firstImageSeconds},
+                     {"flipscope_convert_and_first_image_s", flipscopeFirst()},
+                     {"flipscope_warm_frame_ms", flipscope.warmMeanMs()},
+                     {"flipscope_warm_trace_ms", flipscope.warmTraceMeanMs()},
+                     {"flipscope_convert_peak_rss_bytes", convertPeakBytes},
+                     {"flipscope_render_peak_rss_bytes", flipscope.peakBytes},
+                     {"embree", nullptr}};
+    if (embree)
+      j["embree"] = {{"version", embree->version},
+                     {"build_s", embree->buildSeconds},
+                     {"build_and_first_frame_s", embree->firstFrameSeconds},
+                     {"warm_frame_ms", embree->warmMeanMs()},
+                     {"embree_bytes", embree->embreeBytes},
+                     {"peak_rss_bytes", embree->peakBytes},
+                     {"hits", embree->hits}};
+    return j;
+  }
+  void print() const {
+    const auto gib = [](std::uint64_t bytes) { return double(bytes) / double(1ull << 30); };
+    std::printf("\npeer at %s, the same particles, camera and sphere radius (%.4g world units), CPU:\n", size.c_str(),
+                double(radiusWorld));
+    std::printf("  %-34s %16s %16s %14s %14s\n", "", "prepare s", "+ first image s", "warm frame ms", "peak RSS GiB");
+    if (embree)
+      std::printf("  %-34s %16.2f %16.2f %14.1f %14.2f\n", (embree->version + " sphere points").c_str(),
+                  embree->buildSeconds, embree->firstFrameSeconds, embree->warmMeanMs(), gib(embree->peakBytes));
+    else
+      std::printf("  %-34s %16s\n", "Embree", "not built in (install libembree-dev and build again)");
+    std::printf("  %-34s %16.2f %16.2f %14.1f %14.2f\n", ("flipscope (" + flipscope.device + ")").c_str(),
+                convertSeconds, flipscopeFirst(), flipscope.warmMeanMs(),
+                gib(std::max(convertPeakBytes, flipscope.peakBytes)));
+    std::printf("  (prepare: Embree's BVH build, flipscope's convert; flipscope's warm frames are the ray-caster's "
+                "spheres, %.1f ms of it tracing)\n",
+                flipscope.warmTraceMeanMs());
+    if (!embree) return;
+    std::printf("  target: a warm frame no slower than Embree's: %s (%.2fx)\n",
+                flipscope.warmMeanMs() <= embree->warmMeanMs() ? "met" : "NOT met",
+                flipscope.warmMeanMs() / embree->warmMeanMs());
+    std::printf("  target: convert + first image 10x sooner than Embree's build + first frame: %s (%.1fx sooner)\n",
+                embree->firstFrameSeconds >= 10 * flipscopeFirst() ? "met" : "NOT met",
+                embree->firstFrameSeconds / flipscopeFirst());
+  }
+};
+
+PeerComparison compareWithEmbree(const fs::path& work, const fs::path& particles, double cellSize,
+                                 const Camera& camera, const std::string& size, int orbitFrames) {
+  PeerComparison c;
+  c.size = size;
+  const fs::path store = work / "peer.store", cameraFile = work / "peer_camera.json";
+  saveCamera(cameraFile, camera);
+  fs::remove_all(store);
+  char cell[32];
+  std::snprintf(cell, sizeof cell, "%.17g", cellSize);
+  const ChildRun convert =
+      runFlipscopeChild({"convert", particles.string(), "-o", store.string(), "--cell-size", cell}, work / "peer_convert.log");
+  if (convert.exitCode != 0)
+    throw InputError("bench render: the peer's convert failed; its output is in " + (work / "peer_convert.log").string());
+  c.convertSeconds = convert.seconds;
+  c.convertPeakBytes = convert.peakBytes;
+  FrameStageRequest frame;
+  frame.store = store;
+  frame.size = size;
+  frame.orbitFrames = orbitFrames;
+  frame.device = "cpu";
+  frame.cameraFile = cameraFile;
+  frame.spheres = true;
+  c.flipscope = runFrameStage(frame, work, "peer_flipscope");
+  const StoreHeader header = BrickStore::open(store).header();
+  c.radiusWorld = float(defaultSphereRadius(header, RenderSettings{}.jitter) * header.cellSize);
+  if (embreeAvailable()) c.embree = runEmbreeStage({particles, c.radiusWorld, cameraFile, size, orbitFrames}, work);
+  return c;
 }
 
 void runBenchRender(const BenchRenderArgs& a) {
@@ -163,6 +254,13 @@ void runBenchRender(const BenchRenderArgs& a) {
     vdbTool = timeVdbTool(ply, work / "vdb_tool.png", fluid.cellSize(), 2.0, lastCamera, vw, vh);
   }
 
+  std::optional<PeerComparison> peer;
+  if (!a.peer.empty()) {
+    if (!a.json) std::fprintf(stderr, "bench render: the Embree peer at %ux%u ...\n", vw, vh);
+    peer = compareWithEmbree(work, ply, fluid.cellSize(), lastCamera, std::to_string(vw) + "x" + std::to_string(vh),
+                             a.orbitFrames);
+  }
+
   const SizeResult& main = results.back();
   if (a.json) {
     nlohmann::json j{{"device", deviceName},
@@ -187,6 +285,8 @@ void runBenchRender(const BenchRenderArgs& a) {
                             {"cold_bricks", r.cold.bricksUploaded},
                             {"frame_ms", r.frameMs},
                             {"trace_ms", r.traceMs}});
+    if (peer) j["peer"] = peer->json();
+    else if (!a.peer.empty()) j["peer"] = nullptr;
     printJson(j);
     return;
   }
@@ -214,6 +314,7 @@ void runBenchRender(const BenchRenderArgs& a) {
                 *vdbTool, main.firstImageSeconds, *vdbTool / main.firstImageSeconds);
   else if (!a.skipVdbTool)
     std::printf("\nvdb_tool not found (Debian package libopenvdb-tools): no comparison\n");
+  if (peer) peer->print();
   std::printf("images in %s\n", work.c_str());
 }
 
@@ -234,6 +335,10 @@ void addBenchRenderCommand(CLI::App& bench) {
       ->capture_default_str();
   cmd->add_option("--gpu-mem", args->gpuMem, "Brick pool budget")->capture_default_str();
   cmd->add_flag("--no-vdb-tool", args->skipVdbTool, "Skip the vdb_tool comparison");
+  cmd->add_option("--peer", args->peer,
+                  "Also render the same particles with this peer, in the same run: embree (Embree 3 sphere points, "
+                  "when built in), beside flipscope's convert and CPU ray-caster")
+      ->check(CLI::IsMember({"embree"}));
   cmd->add_flag("--json", args->json, "Machine-readable output");
   cmd->callback([args] { runBenchRender(*args); });
 }
