@@ -16,6 +16,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 #include <glm/common.hpp>
 #include <glm/vector_relational.hpp>
 #include <glm/vec3.hpp>
@@ -29,6 +30,9 @@ constexpr std::size_t kChunkParticles = 1 << 16;
 constexpr std::size_t kNeighbours = kSpacingNeighbour;
 /// Query grids of at most this many cells are indexed directly (16 MiB), larger ones hashed.
 constexpr std::size_t kDenseCells = std::size_t(1) << 22;
+/// Query grids of at most this many cells (with a border of one) get a block mask (64 MiB):
+/// those of a frame of a few billion particles.
+constexpr std::size_t kMaskCells = std::size_t(1) << 26;
 
 /// Spacing per k-th neighbour distance r: at spacing r * ballFactor(), a ball of radius r holds k particles.
 double ballFactor() { return std::cbrt(4 * std::numbers::pi / (3 * double(kSpacingNeighbour))); }
@@ -50,28 +54,69 @@ struct Sample {
   bool complete() const { return finite == positions.size(); }
 };
 
-/// Reservoir sampling (Vitter's algorithm R), one read of the source, then a rewind.
+/// Reservoir sampling of the finite particles (Li's algorithm L: a random skip to the next
+/// particle that enters the sample, so random numbers are drawn only for those, about
+/// size * ln(finite / size) of them), one read of the source, then a rewind. The count and the
+/// bounds of the finite particles are gathered on the way, in parallel over each chunk.
 Sample reservoirSample(ParticleSource& source, std::size_t size, Progress* progress) {
   Sample s;
   std::mt19937_64 rng(0x5041434eull);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  const auto open = [&] { return 1.0 - uniform(rng); };  // in (0, 1]: its log is finite
+  const double k = double(size);
+  double w = std::exp(std::log(open()) / k);
+  // The finite particle (counted from 0) that enters the sample next, once it is full.
+  const auto skip = [&] {
+    const double gap = std::floor(std::log(open()) / std::log1p(-w));
+    return gap < 0x1p62 ? std::uint64_t(gap) + 1 : std::uint64_t(1) << 62;  // (w so small: never)
+  };
+  std::uint64_t next = 0;
   ParticleChunk chunk;
   std::uint64_t id = 0;
+  struct Tally {
+    std::uint64_t finite = 0;
+    Box bounds;
+  };
   while (source.read(chunk, kChunkParticles)) {
-    for (const glm::vec3& p : chunk.positions) {
-      if (isFinite(p)) {
-        ++s.finite;
-        s.bounds.extend(glm::dvec3(p));
-        if (s.positions.size() < size) {
-          s.positions.push_back(p);
-          s.ids.push_back(id);
-        } else if (const std::uint64_t j = std::uniform_int_distribution<std::uint64_t>(0, s.finite - 1)(rng);
-                   j < size) {
-          s.positions[j] = p;
-          s.ids[j] = id;
-        }
+    const std::vector<glm::vec3>& p = chunk.positions;
+    const Tally tally = tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, p.size(), 1 << 14), Tally{},
+        [&](const auto& range, Tally t) {
+          for (std::size_t i = range.begin(); i != range.end(); ++i)
+            if (isFinite(p[i])) ++t.finite, t.bounds.extend(glm::dvec3(p[i]));
+          return t;
+        },
+        [](Tally a, const Tally& b) {
+          a.finite += b.finite;
+          a.bounds.extend(b.bounds);
+          return a;
+        });
+    // The chunk's finite particles are s.finite .. end - 1; visit those that enter the sample.
+    const std::uint64_t end = s.finite + tally.finite;
+    std::uint64_t counted = s.finite;  // finite particles before p[i]
+    for (std::size_t i = 0; i < p.size() && counted < end; ++i) {
+      if (!isFinite(p[i])) continue;
+      if (s.positions.size() < size) {
+        s.positions.push_back(p[i]);
+        s.ids.push_back(id + i);
+        if (s.positions.size() == size) next = counted + skip();
+      } else if (counted == next) {
+        const auto slot = std::uniform_int_distribution<std::size_t>(0, size - 1)(rng);
+        s.positions[slot] = p[i];
+        s.ids[slot] = id + i;
+        w *= std::exp(std::log(open()) / k);
+        next = counted + skip();
+      } else if (p.size() - i == end - counted && next >= end) {
+        break;  // the rest of the chunk is finite and none of it enters the sample
+      } else if (p.size() - i == end - counted) {
+        i += std::size_t(next - counted) - 1;  // all finite from here: jump to the next one in
+        counted = next - 1;
       }
-      ++id;
+      ++counted;
     }
+    s.finite = end;
+    s.bounds.extend(tally.bounds);
+    id += p.size();
     if (progress) progress->advance(chunk.size());
   }
   source.rewind();
@@ -156,18 +201,15 @@ class KthNeighbours {
       return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
     };
     std::sort(mOrder.begin(), mOrder.end(), [&](std::uint32_t a, std::uint32_t b) { return less(cells[a], cells[b]); });
-    // Small grids (the usual case) index their cells directly: mOrder is sorted in the order of
-    // the dense index (x, then y, then z), so each cell's queries are one range of it.
     glm::i64vec3 dims(1);
     for (const glm::ivec3& c : cells) dims = glm::max(dims, glm::i64vec3(c) + std::int64_t(1));
-    if (dims.x * dims.y * dims.z <= std::int64_t(kDenseCells)) {
-      mDims = glm::ivec3(dims);
-      mDenseStart.assign(std::size_t(dims.x * dims.y * dims.z) + 1, 0);
-      for (const glm::ivec3& c : cells) ++mDenseStart[denseIndex(c) + 1];
-      for (std::size_t i = 1; i < mDenseStart.size(); ++i) mDenseStart[i] += mDenseStart[i - 1];
-      // Bit o of a cell's mask: a query lies in the 2x2x2 cells a candidate of the cell visits
-      // when it is in octant o (visit()); over the grid and one cell around it.
-      mBlockMask.assign(std::size_t(dims.x + 2) * std::size_t(dims.y + 2) * std::size_t(dims.z + 2), 0);
+    mDims = glm::ivec3(dims);
+    const auto cellsOf = [](glm::i64vec3 d) { return double(d.x) * double(d.y) * double(d.z); };
+    // Bit o of a cell's mask: a query lies in the 2x2x2 cells a candidate of the cell visits when
+    // it is in octant o (visit()); over the grid and one cell around it. Most candidates lie far
+    // from every query, and this one byte turns them away.
+    if (cellsOf(dims + std::int64_t(2)) <= double(kMaskCells)) {
+      mBlockMask.assign(std::size_t(cellsOf(dims + std::int64_t(2))), 0);
       for (std::size_t i = 0; i < n; ++i) {
         if (i > 0 && cells[mOrder[i]] == cells[mOrder[i - 1]]) continue;
         const glm::ivec3 q = cells[mOrder[i]];
@@ -178,6 +220,13 @@ class KthNeighbours {
             mBlockMask[maskIndex(q - step)] |= std::uint8_t(1u << octant);
           }
       }
+    }
+    // Small grids (the usual case) index their cells directly: mOrder is sorted in the order of
+    // the dense index (x, then y, then z), so each cell's queries are one range of it.
+    if (cellsOf(dims) <= double(kDenseCells)) {
+      mDenseStart.assign(std::size_t(cellsOf(dims)) + 1, 0);
+      for (const glm::ivec3& c : cells) ++mDenseStart[denseIndex(c) + 1];
+      for (std::size_t i = 1; i < mDenseStart.size(); ++i) mDenseStart[i] += mDenseStart[i - 1];
       return;
     }
     std::size_t groups = 0;
@@ -284,9 +333,9 @@ class KthNeighbours {
   glm::dvec3 mOrigin{0}, mLo{0}, mHi{0};
   bool mUsable = false;
   std::vector<std::uint32_t> mOrder;
-  glm::ivec3 mDims{0};                     ///< of the dense index, when mDenseStart is not empty
+  glm::ivec3 mDims{0};                     ///< of the query cells (the dense index and the mask)
   std::vector<std::uint32_t> mDenseStart;  ///< per dense cell, its first query in mOrder; then n
-  std::vector<std::uint8_t> mBlockMask;    ///< with the dense index: see buildTable()
+  std::vector<std::uint8_t> mBlockMask;    ///< empty for the largest grids: see buildTable()
   std::vector<Slot> mTable;                ///< else: the cells with queries, hashed
   std::size_t mMask = 0;
   std::vector<float> mHeaps;  ///< k squared distances per query, a max-heap each

@@ -8,8 +8,8 @@
 //  - metadata (ParticleSource::spacingHint(), nothing read): OpenVDB points grids, the volume of
 //    the active voxels over the points they hold, i.e. voxelSize / cbrt(points per active voxel);
 //  - neighbours (any source): a uniform random sample of up to kSpacingSample finite particles
-//    (reservoir sampling with a fixed seed: deterministic); for each sampled particle, the
-//    distance r to its kSpacingNeighbour-th nearest neighbour among all the source's particles
+//    (reservoir sampling, Li's algorithm L, with a fixed seed: deterministic); for each sampled
+//    particle, the distance r to its kSpacingNeighbour-th nearest neighbour among all the source's particles
 //    (exact, not among the sample only); spacing = median(r) * cbrt(4 pi / (3 k)), the spacing at
 //    which a ball of radius r holds k particles. Within about 2 % of s on a cubic lattice
 //    (r = sqrt(2) s at k = 12), on jittered lattices and on uniform random points. The plain
@@ -21,8 +21,9 @@
 // finite particles, when the median neighbour distance is 0 (coincident particles), or when it is
 // not found within kSpacingMaxPasses reads of the source.
 // Cost of the neighbour estimate: one read of the source when it has at most kSpacingSample
-// particles, else two (rarely more); memory O(kSpacingSample) plus one chunk of particles.
-// The source is rewound afterwards.
+// particles, else two (rarely more); memory O(kSpacingSample) plus one chunk of particles, plus
+// at most 80 MiB for the cell index of the sample (16 MiB) and its block mask (64 MiB), which
+// frames of a few billion particles reach. The source is rewound afterwards.
 #pragma once
 
 #include <cstddef>

@@ -80,6 +80,23 @@ TEST(ParticleSpacing, SampledEstimateReadsEveryParticleForNeighbours) {
   EXPECT_EQ(chunk.positions[0], points[0]);
 }
 
+TEST(ParticleSpacing, SampledEstimateSkipsNonFiniteParticles) {
+  // A sampled source (2000 of 64000) with every 7th particle NaN or infinite, in runs that end
+  // chunks early and late: the sample is drawn from the finite particles only.
+  auto points = lattice(40, 0.5f, 0.5f);
+  const std::size_t all = points.size();
+  std::size_t bad = 0;
+  for (std::size_t i = 3; i < all; i += 7, ++bad)
+    points[i] = i % 2 ? glm::vec3(std::numeric_limits<float>::quiet_NaN()) : glm::vec3(0, std::numeric_limits<float>::infinity(), 0);
+  testing::VectorSource source(points);
+  const SpacingEstimate e = neighbourSpacing(source, 2000);
+  ASSERT_TRUE(e.known()) << e.origin;
+  // A seventh fewer particles in the same volume: the spacing grows by cbrt(7 / 6).
+  EXPECT_NEAR(e.spacing, 0.5 * std::cbrt(7.0 / 6.0), 0.05 * 0.5) << e.origin;
+  EXPECT_NE(e.origin.find("2000 sampled of " + std::to_string(all - bad) + " particles"), std::string::npos) << e.origin;
+  EXPECT_EQ(neighbourSpacing(source, 2000).spacing, e.spacing) << "deterministic";
+}
+
 TEST(ParticleSpacing, FarApartClustersGiveTheSameSpacingAsOne) {
   // Two sampled lattices 10^4 spacings apart: the grid of query cells spans more cells than
   // are indexed directly, so the cells are hashed; the estimate is the one of a lattice alone,
