@@ -30,9 +30,11 @@ constexpr std::size_t kChunkParticles = 1 << 16;
 constexpr std::size_t kNeighbours = kSpacingNeighbour;
 /// Query grids of at most this many cells are indexed directly (16 MiB), larger ones hashed.
 constexpr std::size_t kDenseCells = std::size_t(1) << 22;
-/// Query grids of at most this many cells (with a border of one) get a block mask (64 MiB):
-/// those of a frame of a few billion particles.
-constexpr std::size_t kMaskCells = std::size_t(1) << 26;
+/// Query grids of at most this many cells (with a border of one) get a byte per cell of block
+/// mask (4 MiB, cache-sized); up to kNearCells, a bit per cell (64 MiB) saying whether a query
+/// lies in the 27 cells around: those of frames of a few billion particles.
+constexpr std::size_t kMaskCells = std::size_t(1) << 22;
+constexpr std::size_t kNearCells = std::size_t(1) << 29;
 
 /// Spacing per k-th neighbour distance r: at spacing r * ballFactor(), a ball of radius r holds k particles.
 double ballFactor() { return std::cbrt(4 * std::numbers::pi / (3 * double(kSpacingNeighbour))); }
@@ -205,21 +207,32 @@ class KthNeighbours {
     for (const glm::ivec3& c : cells) dims = glm::max(dims, glm::i64vec3(c) + std::int64_t(1));
     mDims = glm::ivec3(dims);
     const auto cellsOf = [](glm::i64vec3 d) { return double(d.x) * double(d.y) * double(d.z); };
-    // Bit o of a cell's mask: a query lies in the 2x2x2 cells a candidate of the cell visits when
-    // it is in octant o (visit()); over the grid and one cell around it. Most candidates lie far
-    // from every query, and this one byte turns them away.
-    if (cellsOf(dims + std::int64_t(2)) <= double(kMaskCells)) {
-      mBlockMask.assign(std::size_t(cellsOf(dims + std::int64_t(2))), 0);
-      for (std::size_t i = 0; i < n; ++i) {
-        if (i > 0 && cells[mOrder[i]] == cells[mOrder[i - 1]]) continue;
-        const glm::ivec3 q = cells[mOrder[i]];
-        for (int octant = 0; octant < 8; ++octant)
-          for (int corner = 0; corner < 8; ++corner) {
-            const glm::ivec3 step(corner & 1 ? octantSide(octant, 0) : 0, corner & 2 ? octantSide(octant, 1) : 0,
-                                  corner & 4 ? octantSide(octant, 2) : 0);
-            mBlockMask[maskIndex(q - step)] |= std::uint8_t(1u << octant);
-          }
+    // Bit o of a cell's byte of mask: a query lies in the 2x2x2 cells a candidate of the cell
+    // visits when it is in octant o (visit()); over the grid and one cell around it. Most
+    // candidates lie far from every query, and this one byte turns them away.
+    // Larger grids get a bit per cell: a query lies in the 3x3x3 cells around, a coarser test
+    // that fits in the caches where a byte a cell would not (every candidate looks it up).
+    const double maskCells = cellsOf(dims + std::int64_t(2));
+    if (maskCells <= double(kMaskCells)) mBlockMask.assign(std::size_t(maskCells), 0);
+    else if (maskCells <= double(kNearCells)) mNearBits.assign((std::size_t(maskCells) + 63) / 64, 0);
+    for (std::size_t i = 0; i < n && (!mBlockMask.empty() || !mNearBits.empty()); ++i) {
+      if (i > 0 && cells[mOrder[i]] == cells[mOrder[i - 1]]) continue;
+      const glm::ivec3 q = cells[mOrder[i]];
+      if (!mNearBits.empty()) {
+        for (int z = -1; z <= 1; ++z)
+          for (int y = -1; y <= 1; ++y)
+            for (int x = -1; x <= 1; ++x) {
+              const std::size_t bit = maskIndex(q + glm::ivec3(x, y, z));
+              mNearBits[bit / 64] |= std::uint64_t(1) << (bit % 64);
+            }
+        continue;
       }
+      for (int octant = 0; octant < 8; ++octant)
+        for (int corner = 0; corner < 8; ++corner) {
+          const glm::ivec3 step(corner & 1 ? octantSide(octant, 0) : 0, corner & 2 ? octantSide(octant, 1) : 0,
+                                corner & 4 ? octantSide(octant, 2) : 0);
+          mBlockMask[maskIndex(q - step)] |= std::uint8_t(1u << octant);
+        }
     }
     // Small grids (the usual case) index their cells directly: mOrder is sorted in the order of
     // the dense index (x, then y, then z), so each cell's queries are one range of it.
@@ -245,7 +258,7 @@ class KthNeighbours {
 
   /// The side (-1 or 1) of `axis` of octant o: bit `axis` of o set is the upper half.
   static int octantSide(int octant, int axis) { return octant >> axis & 1 ? 1 : -1; }
-  /// Index into mBlockMask of a cell in [-1, mDims] on every axis.
+  /// Index into mBlockMask (or bit of mNearBits) of a cell in [-1, mDims] on every axis.
   std::size_t maskIndex(const glm::ivec3& c) const {
     return (std::size_t(c.x + 1) * std::size_t(mDims.y + 2) + std::size_t(c.y + 1)) * std::size_t(mDims.z + 2) +
            std::size_t(c.z + 1);
@@ -309,10 +322,11 @@ class KthNeighbours {
     // A query within radius = half a cell lies in this cell or the neighbour on the side of
     // the half the candidate is in, on every axis.
     const glm::ivec3 side(f.x - base.x < 0.5 ? -1 : 1, f.y - base.y < 0.5 ? -1 : 1, f.z - base.z < 0.5 ? -1 : 1);
-    if (!mBlockMask.empty()) {  // most candidates have no query near: one byte says so
+    if (!mBlockMask.empty() || !mNearBits.empty()) {  // most candidates have no query near
       if (glm::any(glm::lessThan(cell, glm::ivec3(-1))) || glm::any(glm::greaterThan(cell, mDims))) return;
+      const std::size_t m = maskIndex(cell);
       const int octant = (side.x > 0 ? 1 : 0) | (side.y > 0 ? 2 : 0) | (side.z > 0 ? 4 : 0);
-      if (!(mBlockMask[maskIndex(cell)] >> octant & 1)) return;
+      if (mNearBits.empty() ? !(mBlockMask[m] >> octant & 1) : !(mNearBits[m / 64] >> (m % 64) & 1)) return;
     }
     const float radius2 = float(mRadius * mRadius);
     for (int corner = 0; corner < 8; ++corner) {
@@ -335,7 +349,8 @@ class KthNeighbours {
   std::vector<std::uint32_t> mOrder;
   glm::ivec3 mDims{0};                     ///< of the query cells (the dense index and the mask)
   std::vector<std::uint32_t> mDenseStart;  ///< per dense cell, its first query in mOrder; then n
-  std::vector<std::uint8_t> mBlockMask;    ///< empty for the largest grids: see buildTable()
+  std::vector<std::uint8_t> mBlockMask;    ///< small grids: see buildTable()
+  std::vector<std::uint64_t> mNearBits;    ///< larger grids: see buildTable()
   std::vector<Slot> mTable;                ///< else: the cells with queries, hashed
   std::size_t mMask = 0;
   std::vector<float> mHeaps;  ///< k squared distances per query, a max-heap each

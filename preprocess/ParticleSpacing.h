@@ -22,8 +22,8 @@
 // not found within kSpacingMaxPasses reads of the source.
 // Cost of the neighbour estimate: one read of the source when it has at most kSpacingSample
 // particles, else two (rarely more); memory O(kSpacingSample) plus one chunk of particles, plus
-// at most 80 MiB for the cell index of the sample (16 MiB) and its block mask (64 MiB), which
-// frames of a few billion particles reach. The source is rewound afterwards.
+// at most 80 MiB for the cell index of the sample (16 MiB) and its mask of the cells near it
+// (64 MiB), which frames of a few billion particles reach. The source is rewound afterwards.
 #pragma once
 
 #include <cstddef>

@@ -98,23 +98,26 @@ TEST(ParticleSpacing, SampledEstimateSkipsNonFiniteParticles) {
 }
 
 TEST(ParticleSpacing, FarApartClustersGiveTheSameSpacingAsOne) {
-  // Two sampled lattices 10^4 spacings apart: the grid of query cells spans more cells than
-  // are indexed directly, so the cells are hashed; the estimate is the one of a lattice alone,
-  // exactly, since every neighbour lies in its own lattice.
-  auto points = lattice(40, 0.5f, 0.5f);
-  const auto far = lattice(40, 0.5f, 0.5f, glm::vec3(5000, -3000, 4000), 9);
-  points.insert(points.end(), far.begin(), far.end());
-  testing::VectorSource both(points);
-  const SpacingEstimate e = neighbourSpacing(both, 2000);
-  ASSERT_TRUE(e.known()) << e.origin;
-  EXPECT_NEAR(e.spacing, 0.5, 0.05 * 0.5) << e.origin;
-  EXPECT_NE(e.origin.find("2000 sampled of 128000 particles"), std::string::npos) << e.origin;
-  // The bounds of every finite particle come with the estimate that read them all.
-  ASSERT_TRUE(e.bounds);
-  Box expected;
-  for (const glm::vec3& p : points) expected.extend(glm::dvec3(p));
-  EXPECT_EQ(e.bounds->min, expected.min);
-  EXPECT_EQ(e.bounds->max, expected.max);
+  // Two sampled lattices far apart: the grid of query cells spans more cells than are indexed
+  // directly, so the cells are hashed, and candidates are turned away by a bit per cell (500
+  // spacings apart: 15 M cells) or by nothing (10^4 apart). The estimate is the one of a
+  // lattice alone, since every neighbour lies in its own lattice.
+  for (const glm::vec3 offset : {glm::vec3(500, 500, 500), glm::vec3(5000, -3000, 4000)}) {
+    auto points = lattice(40, 0.5f, 0.5f);
+    const auto far = lattice(40, 0.5f, 0.5f, offset, 9);
+    points.insert(points.end(), far.begin(), far.end());
+    testing::VectorSource both(points);
+    const SpacingEstimate e = neighbourSpacing(both, 2000);
+    ASSERT_TRUE(e.known()) << e.origin;
+    EXPECT_NEAR(e.spacing, 0.5, 0.05 * 0.5) << e.origin;
+    EXPECT_NE(e.origin.find("2000 sampled of 128000 particles"), std::string::npos) << e.origin;
+    // The bounds of every finite particle come with the estimate that read them all.
+    ASSERT_TRUE(e.bounds);
+    Box expected;
+    for (const glm::vec3& p : points) expected.extend(glm::dvec3(p));
+    EXPECT_EQ(e.bounds->min, expected.min);
+    EXPECT_EQ(e.bounds->max, expected.max);
+  }
 }
 
 TEST(ParticleSpacing, NonFiniteSkippedAndDegenerateInputsUnknown) {
