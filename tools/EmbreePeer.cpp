@@ -1,7 +1,10 @@
 #include "tools/EmbreePeer.h"
 
+#include <atomic>
 #include <chrono>
+#include <cmath>
 #include <fstream>
+#include <limits>
 
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
@@ -25,16 +28,17 @@ namespace flipscope::tools {
 namespace {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
 
 struct EmbreeStageArgs {
   EmbreeStageRequest request;
   std::string particles, cameraFile, statsFile, image;
 };
 
-double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
 #if FLIPSCOPE_HAVE_EMBREE
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 /// Embree's own allocations, through its memory monitor.
 struct EmbreeMemory {

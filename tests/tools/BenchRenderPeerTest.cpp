@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cstdlib>
 #include <cmath>
 #include <string>
 
@@ -46,7 +47,10 @@ TEST(BenchRenderPeer, EmbreeAndFlipscopeRenderTheSameParticlesWithTheSameCamera)
   EXPECT_NEAR(peer["flipscope_convert_and_first_image_s"].get<double>(),
               peer["flipscope_convert_s"].get<double>() + peer["flipscope_first_image_s"].get<double>(), 1e-9);
   EXPECT_GT(peer["flipscope_render_peak_rss_bytes"].get<double>(), 0.0);
-  ASSERT_FALSE(peer["embree"].is_null()) << "Embree is installed by .ci/install-deps: " << run.output;
+  if (peer["embree"].is_null()) {  // built without Embree (it is optional)
+    ASSERT_EQ(std::getenv("FLIPSCOPE_REQUIRE_EMBREE"), nullptr) << "CI installs libembree-dev: " << run.output;
+    GTEST_SKIP() << "this flipscope is built without Embree (Debian: libembree-dev)";
+  }
   const auto& embree = peer["embree"];
   std::uint32_t w = 0, h = 0;
   EXPECT_EQ(embree["version"].get<std::string>().rfind("Embree 3.", 0), 0u);
