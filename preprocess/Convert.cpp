@@ -21,6 +21,7 @@
 #include "core/AtomicFile.h"
 #include "core/Error.h"
 #include "preprocess/BrickBinning.h"
+#include "preprocess/FiniteBounds.h"
 #include "preprocess/store/FrameFile.h"
 #include "preprocess/store/StoreLock.h"
 #include "preprocess/ParticleSpacing.h"
@@ -436,19 +437,7 @@ Box scanBounds(ParticleSource& source, std::size_t chunkParticles, bool readAhea
   std::optional<PrefetchingSource> ahead;
   ParticleSource& input = readingAhead(source, readAhead, ahead);
   while (input.read(chunk, chunkParticles)) {
-    bounds.extend(tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, chunk.size(), 1 << 15), Box{},
-        [&](const auto& range, Box b) {
-          for (std::size_t i = range.begin(); i != range.end(); ++i) {
-            const glm::vec3 p = chunk.positions[i];
-            if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) b.extend(glm::dvec3(p));
-          }
-          return b;
-        },
-        [](Box a, const Box& b) {
-          a.extend(b);
-          return a;
-        }));
+    bounds.extend(finiteBounds(chunk.positions).bounds);
     if (progress) progress->advance(chunk.size());
   }
   source.rewind();

@@ -16,12 +16,12 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
 #include <glm/common.hpp>
 #include <glm/vector_relational.hpp>
 #include <glm/vec3.hpp>
 
 #include "core/Error.h"
+#include "preprocess/FiniteBounds.h"
 
 namespace flipscope {
 namespace {
@@ -75,24 +75,9 @@ Sample reservoirSample(ParticleSource& source, std::size_t size, Progress* progr
   std::uint64_t next = 0;
   ParticleChunk chunk;
   std::uint64_t id = 0;
-  struct Tally {
-    std::uint64_t finite = 0;
-    Box bounds;
-  };
   while (source.read(chunk, kChunkParticles)) {
     const std::vector<glm::vec3>& p = chunk.positions;
-    const Tally tally = tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, p.size(), 1 << 14), Tally{},
-        [&](const auto& range, Tally t) {
-          for (std::size_t i = range.begin(); i != range.end(); ++i)
-            if (isFinite(p[i])) ++t.finite, t.bounds.extend(glm::dvec3(p[i]));
-          return t;
-        },
-        [](Tally a, const Tally& b) {
-          a.finite += b.finite;
-          a.bounds.extend(b.bounds);
-          return a;
-        });
+    const FiniteBounds tally = finiteBounds(p);
     // The chunk's finite particles are s.finite .. end - 1; visit those that enter the sample.
     const std::uint64_t end = s.finite + tally.finite;
     std::uint64_t counted = s.finite;  // finite particles before p[i]
@@ -108,10 +93,9 @@ Sample reservoirSample(ParticleSource& source, std::size_t size, Progress* progr
         s.ids[slot] = id + i;
         w *= std::exp(std::log(open()) / k);
         next = counted + skip();
-      } else if (p.size() - i == end - counted && next >= end) {
-        break;  // the rest of the chunk is finite and none of it enters the sample
-      } else if (p.size() - i == end - counted) {
-        i += std::size_t(next - counted) - 1;  // all finite from here: jump to the next one in
+      } else if (p.size() - i == end - counted) {  // all finite from here: jump to the next one in
+        if (next >= end) break;                     // (none of them enters the sample)
+        i += std::size_t(next - counted) - 1;
         counted = next - 1;
       }
       ++counted;
@@ -218,21 +202,21 @@ class KthNeighbours {
     for (std::size_t i = 0; i < n && (!mBlockMask.empty() || !mNearBits.empty()); ++i) {
       if (i > 0 && cells[mOrder[i]] == cells[mOrder[i - 1]]) continue;
       const glm::ivec3 q = cells[mOrder[i]];
-      if (!mNearBits.empty()) {
+      if (!mBlockMask.empty()) {
+        for (int octant = 0; octant < 8; ++octant)
+          for (int corner = 0; corner < 8; ++corner) {
+            const glm::ivec3 step(corner & 1 ? octantSide(octant, 0) : 0, corner & 2 ? octantSide(octant, 1) : 0,
+                                  corner & 4 ? octantSide(octant, 2) : 0);
+            mBlockMask[maskIndex(q - step)] |= std::uint8_t(1u << octant);
+          }
+      } else {
         for (int z = -1; z <= 1; ++z)
           for (int y = -1; y <= 1; ++y)
             for (int x = -1; x <= 1; ++x) {
               const std::size_t bit = maskIndex(q + glm::ivec3(x, y, z));
               mNearBits[bit / 64] |= std::uint64_t(1) << (bit % 64);
             }
-        continue;
       }
-      for (int octant = 0; octant < 8; ++octant)
-        for (int corner = 0; corner < 8; ++corner) {
-          const glm::ivec3 step(corner & 1 ? octantSide(octant, 0) : 0, corner & 2 ? octantSide(octant, 1) : 0,
-                                corner & 4 ? octantSide(octant, 2) : 0);
-          mBlockMask[maskIndex(q - step)] |= std::uint8_t(1u << octant);
-        }
     }
     // Small grids (the usual case) index their cells directly: mOrder is sorted in the order of
     // the dense index (x, then y, then z), so each cell's queries are one range of it.

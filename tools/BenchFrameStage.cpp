@@ -30,12 +30,6 @@ struct FrameStageArgs {
 
 double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-double mean(const std::vector<double>& values) {
-  double sum = 0;
-  for (double v : values) sum += v;
-  return values.empty() ? 0 : sum / double(values.size());
-}
-
 void runStage(const FrameStageArgs& a) {
   const auto [width, height] = parseImageSize("--size", a.request.size);
   const auto start = Clock::now();
@@ -71,7 +65,6 @@ void runStage(const FrameStageArgs& a) {
   }
   const nlohmann::json j{{"device", pipeline.deviceName()},
                          {"first_image_s", firstSeconds},
-                         {"first_trace_ms", first.stats.traceMs},
                          {"bricks_touched", first.stats.bricksUploaded},
                          {"frame_bricks", first.stats.frameBricks},
                          {"warm_frame_ms", warm},
@@ -82,8 +75,14 @@ void runStage(const FrameStageArgs& a) {
 
 }  // namespace
 
-double FrameStageResult::warmMeanMs() const { return mean(warmFrameMs); }
-double FrameStageResult::warmTraceMeanMs() const { return mean(warmTraceMs); }
+double meanOf(const std::vector<double>& values) {
+  double sum = 0;
+  for (double v : values) sum += v;
+  return values.empty() ? 0 : sum / double(values.size());
+}
+
+double FrameStageResult::warmMeanMs() const { return meanOf(warmFrameMs); }
+double FrameStageResult::warmTraceMeanMs() const { return meanOf(warmTraceMs); }
 
 FrameStageResult runFrameStage(const FrameStageRequest& request, const fs::path& work, const std::string& name) {
   const fs::path stats = work / (name + ".json"), log = work / (name + ".log");
@@ -102,16 +101,12 @@ FrameStageResult runFrameStage(const FrameStageRequest& request, const fs::path&
                                      request.device};
   if (!request.cameraFile.empty()) arguments.insert(arguments.end(), {"--camera-file", request.cameraFile.string()});
   if (request.spheres) arguments.push_back("--spheres");
-  const ChildRun run = runFlipscopeChild(arguments, log);
-  if (run.exitCode != 0)
-    throw InputError("bench: the frame stage (" + name + ") failed (exit code " + std::to_string(run.exitCode) +
-                     "); its output is in " + log.string());
+  runFlipscopeStage("frame stage (" + name + ")", arguments, log);
   std::ifstream in(stats);
   const nlohmann::json j = nlohmann::json::parse(in);
   FrameStageResult r;
   r.device = j["device"].get<std::string>();
   r.firstImageSeconds = j["first_image_s"].get<double>();
-  r.firstTraceMs = j["first_trace_ms"].get<double>();
   r.bricksTouched = j["bricks_touched"].get<std::uint64_t>();
   r.frameBricks = j["frame_bricks"].get<std::uint64_t>();
   r.warmFrameMs = j["warm_frame_ms"].get<std::vector<double>>();

@@ -27,7 +27,6 @@ struct FrameStageRequest {
 struct FrameStageResult {
   std::string device;
   double firstImageSeconds = 0;     ///< store opened to converged first image
-  double firstTraceMs = 0;          ///< the ray-caster's share of it
   std::uint64_t bricksTouched = 0;  ///< uploaded for the first image
   std::uint64_t frameBricks = 0;    ///< non-empty bricks of the frame
   std::vector<double> warmFrameMs;  ///< each warm frame of the orbit, whole
@@ -42,6 +41,9 @@ struct FrameStageResult {
 /// Throws InputError naming the log when it fails.
 FrameStageResult runFrameStage(const FrameStageRequest& request, const std::filesystem::path& work,
                                const std::string& name);
+
+/// The mean of `values`; 0 for none.
+double meanOf(const std::vector<double>& values);
 
 /// The degrees between two frames of the benchmarks' orbits, about the up axis.
 inline constexpr double kOrbitStepDegrees = 2.0;

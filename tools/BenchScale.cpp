@@ -46,14 +46,10 @@ std::uint64_t directoryBytes(const fs::path& dir) {
   return bytes;
 }
 
-/// Runs one stage; throws naming it and its log when it fails.
+/// Runs one stage, saying so; throws naming it and its log when it fails.
 ChildRun runStage(const char* name, const std::vector<std::string>& arguments, const fs::path& log, bool quiet) {
   if (!quiet) std::fprintf(stderr, "bench scale: %s ...\n", name);
-  const ChildRun run = runFlipscopeChild(arguments, log);
-  if (run.exitCode != 0)
-    throw InputError(std::string("bench scale: the ") + name + " stage failed (exit code " +
-                     std::to_string(run.exitCode) + "); its output is in " + log.string());
-  return run;
+  return runFlipscopeStage(std::string(name) + " stage", arguments, log);
 }
 
 void runBenchScale(const BenchScaleArgs& a) {

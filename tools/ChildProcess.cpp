@@ -10,6 +10,8 @@
 #include <chrono>
 #include <cstdio>
 
+#include "core/Error.h"
+
 extern char** environ;
 
 namespace flipscope::tools {
@@ -42,6 +44,15 @@ ChildRun runFlipscopeChild(const std::vector<std::string>& arguments, const std:
     while (std::fgets(line, sizeof line, out)) std::sscanf(line, "peak memory %lf MiB", &run.reportedPeakMiB);
     std::fclose(out);
   }
+  return run;
+}
+
+ChildRun runFlipscopeStage(const std::string& what, const std::vector<std::string>& arguments,
+                           const std::filesystem::path& log) {
+  const ChildRun run = runFlipscopeChild(arguments, log);
+  if (run.exitCode != 0)
+    throw InputError("bench: the " + what + " failed (exit code " + std::to_string(run.exitCode) +
+                     "); its output is in " + log.string());
   return run;
 }
 

@@ -21,4 +21,9 @@ struct ChildRun {
 /// and waits for it.
 ChildRun runFlipscopeChild(const std::vector<std::string>& arguments, const std::filesystem::path& log);
 
+/// runFlipscopeChild() for a stage of a benchmark that cannot go on without it: throws
+/// InputError naming the stage (`what`), its exit code and `log` when it does not exit with 0.
+ChildRun runFlipscopeStage(const std::string& what, const std::vector<std::string>& arguments,
+                           const std::filesystem::path& log);
+
 }  // namespace flipscope::tools

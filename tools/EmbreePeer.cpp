@@ -6,9 +6,9 @@
 #include <fstream>
 #include <limits>
 
+#include <tbb/parallel_for.h>
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
-#include <tbb/parallel_for.h>
 
 #if FLIPSCOPE_HAVE_EMBREE
 #include <embree3/rtcore.h>
@@ -68,7 +68,8 @@ std::uint64_t traceFrame(RTCScene scene, const Camera& camera, std::uint32_t wid
       for (int i = 0; i < 16; ++i) {
         const std::uint32_t x = px * 4 + std::uint32_t(i % 4), y = py * 4 + std::uint32_t(i / 4);
         valid[i] = x < width && y < height ? -1 : 0;
-        const glm::dvec3 d = camera.pixelRay(double(std::min(x, width - 1)), double(std::min(y, height - 1)), width, height);
+        const glm::dvec3 d =
+            camera.pixelRay(double(std::min(x, width - 1)), double(std::min(y, height - 1)), width, height);
         rays.ray.org_x[i] = float(camera.eye.x);
         rays.ray.org_y[i] = float(camera.eye.y);
         rays.ray.org_z[i] = float(camera.eye.z);
@@ -115,7 +116,8 @@ void runStage(const EmbreeStageArgs& a) {
   EmbreeMemory memory;
   const auto start = Clock::now();
   RTCDevice device = rtcNewDevice(nullptr);
-  if (!device) throw InputError("Embree: rtcNewDevice failed (error " + std::to_string(rtcGetDeviceError(nullptr)) + ")");
+  if (!device)
+    throw InputError("Embree: rtcNewDevice failed (error " + std::to_string(rtcGetDeviceError(nullptr)) + ")");
   rtcSetDeviceMemoryMonitorFunction(device, &EmbreeMemory::monitor, &memory);
   RTCScene scene = rtcNewScene(device);
   rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_LOW);
@@ -170,24 +172,18 @@ void runStage(const EmbreeStageArgs&) {
 
 bool embreeAvailable() { return FLIPSCOPE_HAVE_EMBREE; }
 
-double EmbreeStageResult::warmMeanMs() const {
-  double sum = 0;
-  for (double ms : warmFrameMs) sum += ms;
-  return warmFrameMs.empty() ? 0 : sum / double(warmFrameMs.size());
-}
+double EmbreeStageResult::warmMeanMs() const { return meanOf(warmFrameMs); }
 
 EmbreeStageResult runEmbreeStage(const EmbreeStageRequest& request, const fs::path& work) {
   const fs::path stats = work / "embree.json", log = work / "embree.log";
   char radius[32];
   std::snprintf(radius, sizeof radius, "%.9g", double(request.radius));
-  const ChildRun run = runFlipscopeChild(
+  runFlipscopeStage(
+      "Embree stage",
       {"bench", "embree-stage", request.particles.string(), "--radius", radius, "--camera-file",
        request.cameraFile.string(), "--size", request.size, "--orbit-frames", std::to_string(request.orbitFrames),
        "--stats-file", stats.string(), "--image", (work / "embree.png").string()},
       log);
-  if (run.exitCode != 0)
-    throw InputError("bench: the Embree stage failed (exit code " + std::to_string(run.exitCode) +
-                     "); its output is in " + log.string());
   std::ifstream in(stats);
   const nlohmann::json j = nlohmann::json::parse(in);
   EmbreeStageResult r;
