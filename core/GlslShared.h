@@ -22,7 +22,6 @@ using uint = std::uint32_t;
 using glm::abs;
 using glm::clamp;
 using glm::dot;
-using glm::floor;
 using glm::ivec2;
 using glm::ivec3;
 using glm::ivec4;
@@ -36,7 +35,6 @@ using glm::vec2;
 using glm::vec3;
 using glm::vec4;
 using std::abs;
-using std::floor;
 using std::sqrt;
 using glm::cross;
 using glm::exp;
@@ -49,7 +47,29 @@ using glm::atan;
 using std::exp;
 using std::pow;
 
-inline int bitCount(uint v) { return std::popcount(v); }
+/// GLSL's floor. Without SSE4.1 (x86-64's baseline) std::floor is a call into libm, and the
+/// ray-casters floor every sample point; this is exact for every float (beyond 2^23 a float is
+/// an integer already; NaN and infinities come back as they are).
+inline float floor(float v) {
+  if (!(std::abs(v) < 8388608.0f)) return v;
+  const float truncated = float(int(v));
+  return truncated > v ? truncated - 1.0f : truncated;
+}
+inline vec2 floor(vec2 v) { return vec2(floor(v.x), floor(v.y)); }
+inline vec3 floor(vec3 v) { return vec3(floor(v.x), floor(v.y), floor(v.z)); }
+inline vec4 floor(vec4 v) { return vec4(floor(v.x), floor(v.y), floor(v.z), floor(v.w)); }
+
+/// GLSL's bitCount. Without the POPCNT instruction (x86-64's baseline) std::popcount is a call
+/// into libgcc; the same bit trick inline is about twice as fast.
+inline int bitCount(uint v) {
+#if defined(__POPCNT__) || !defined(__x86_64__)
+  return std::popcount(v);
+#else
+  v = v - ((v >> 1u) & 0x55555555u);
+  v = (v & 0x33333333u) + ((v >> 2u) & 0x33333333u);
+  return int((((v + (v >> 4u)) & 0x0f0f0f0fu) * 0x01010101u) >> 24u);
+#endif
+}
 inline int findLSB(uint v) { return v == 0 ? -1 : std::countr_zero(v); }
 inline int findMSB(uint v) { return v == 0 ? -1 : 31 - std::countl_zero(v); }
 inline float uintBitsToFloat(uint v) { return std::bit_cast<float>(v); }

@@ -1,57 +1,16 @@
 #include "raycast/CpuRaycaster.h"
 
 #include <chrono>
+#include <memory>
 #include <thread>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include "core/Error.h"
-#include "streaming/BitBrickLayout.h"
-#include "streaming/Jitter.h"
+#include "raycast/CpuRaycastKernel.h"
 
 namespace flipscope {
-
-namespace glsl {
-namespace {
-/// Raycast.glsl compiled as C++: its functions become members, so the accessors it calls (and
-/// the parameter block P) are this struct's members, as they are globals in Raycast.comp.
-struct RaycastKernel {
-  RaycastParams P;
-  const CpuRaycaster::Pool* pool;
-  std::atomic<std::uint8_t>* requestFlags;
-
-  uvec2 rcNode(uint node) const { return pool->nodes[node]; }
-  uint rcPage(uint brickIndex) const { return pool->pageTable[brickIndex]; }
-  uvec4 rcSubBrick(uint slot, uint subBrick) const { return pool->subBricks[std::size_t(slot) * P.brick.w + subBrick]; }
-  uint rcMipWord(uint slot, uint word) const { return pool->mipWords[std::size_t(slot) * P.pool.x + word]; }
-  uint rcAttributeBase(uint slot, uint subBrick) const {
-    return pool->attributeBases[std::size_t(slot) * P.brick.w + subBrick];
-  }
-  uint rcAttribute(uint index) const { return pool->attributes[index]; }
-  void rcRequest(uint brickIndex) const { requestFlags[brickIndex].store(1, std::memory_order_relaxed); }
-  uvec4 rcFoamSubBrick(uint slot, uint subBrick) const {
-    return pool->foamBits[std::size_t(slot) * P.brick.w + subBrick];
-  }
-  uint rcFoamOccupancy(uint slot, uint word) const {
-    return pool->foamOccupancy[std::size_t(slot) * pool->layout.foamOccupancyWords() + word];
-  }
-
-#include "raycast/glsl/Raycast.glsl"
-};
-
-/// FoamClassify.glsl compiled as C++, the same way.
-struct FoamKernel {
-  FoamClassifyParams FP;
-  const CpuRaycaster::Pool* pool;
-
-  uvec4 fcSubBrick(uint slot, uint subBrick) const { return pool->subBricks[std::size_t(slot) * FP.brick.z + subBrick]; }
-  uvec4 fcFoam(uint slot, uint subBrick) const { return pool->foamBits[std::size_t(slot) * FP.brick.z + subBrick]; }
-
-#include "raycast/glsl/FoamClassify.glsl"
-};
-}  // namespace
-}  // namespace glsl
 
 std::vector<std::uint32_t> attributeBases(const BitBrick& bits, std::uint64_t attributeOffset) {
   std::vector<std::uint32_t> bases(bits.subBricks.size(), 0);
@@ -150,28 +109,34 @@ void CpuRaycaster::beginImage(std::uint32_t width, std::uint32_t height) {
   mHits.assign(std::size_t(width) * height, RayHit{});  // zeros: fresh pending rays
 }
 
-std::vector<std::uint32_t> CpuRaycaster::trace(const RaycastParams& params) {
+std::vector<std::uint32_t> CpuRaycaster::timedPass(
+    const RaycastParams& params, const std::function<void(const glsl::RaycastPoolAccess& access)>& pass) {
   FLIPSCOPE_CHECK(params.image.x == mWidth && params.image.y == mHeight);
   const auto start = std::chrono::steady_clock::now();
   const std::size_t brickCount = mPool.pageTable.size();
   std::unique_ptr<std::atomic<std::uint8_t>[]> flags(
       new std::atomic<std::uint8_t>[std::max<std::size_t>(brickCount, 1)]);
   for (std::size_t i = 0; i < brickCount; ++i) flags[i].store(0, std::memory_order_relaxed);
-  const glsl::RaycastKernel kernel{params, &mPool, flags.get()};
-  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, mHeight), [&](const tbb::blocked_range<std::uint32_t>& rows) {
-    glsl::RaycastKernel local = kernel;  // the shared functions are non-const members
-    for (std::uint32_t y = rows.begin(); y != rows.end(); ++y) {
-      for (std::uint32_t x = 0; x < mWidth; ++x) {
-        RayHit& ray = mHits[std::size_t(y) * mWidth + x];
-        if (local.rcNeedsPass(ray)) ray = local.rcPass(glm::uvec2(x, y), ray);
-      }
-    }
-  });
+  pass(glsl::RaycastPoolAccess{params, &mPool, flags.get()});
   std::vector<std::uint32_t> requests;
   for (std::size_t i = 0; i < brickCount; ++i)
     if (flags[i].load(std::memory_order_relaxed)) requests.push_back(std::uint32_t(i));
   mLastTraceMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return requests;
+}
+
+std::vector<std::uint32_t> CpuRaycaster::trace(const RaycastParams& params) {
+  return timedPass(params, [&](const glsl::RaycastPoolAccess& access) {
+    tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, mHeight), [&](const tbb::blocked_range<std::uint32_t>& rows) {
+      glsl::RaycastKernel kernel{access};  // the shared functions are non-const members
+      for (std::uint32_t y = rows.begin(); y != rows.end(); ++y) {
+        for (std::uint32_t x = 0; x < mWidth; ++x) {
+          RayHit& ray = mHits[std::size_t(y) * mWidth + x];
+          if (kernel.rcNeedsPass(ray)) ray = kernel.rcPass(glm::uvec2(x, y), ray);
+        }
+      }
+    });
+  });
 }
 
 }  // namespace flipscope

@@ -4,13 +4,16 @@
 // GPU's images with it pixel by pixel.
 #pragma once
 
-#include <atomic>
-#include <memory>
+#include <functional>
 
 #include "core/UninitializedVector.h"
 #include "raycast/RaycastDevice.h"
 
 namespace flipscope {
+
+namespace glsl {
+struct RaycastPoolAccess;
+}
 
 class CpuRaycaster : public RaycastDevice {
  public:
@@ -45,10 +48,18 @@ class CpuRaycaster : public RaycastDevice {
   };
   const Pool& pool() const { return mPool; }
 
- private:
+ protected:
+  /// One pass of trace(): `pass` continues the pending rays of mHits through the pool that
+  /// `access` reads, whose rcRequest flags the bricks they stop at. Returns those bricks
+  /// ascending and records lastTraceMs.
+  std::vector<std::uint32_t> timedPass(const RaycastParams& params,
+                                       const std::function<void(const glsl::RaycastPoolAccess& access)>& pass);
+
   Pool mPool;
   std::vector<RayHit> mHits;
   std::uint32_t mWidth = 0, mHeight = 0;
+
+ private:
   double mLastTraceMs = 0;
   double mLastClassifyMs = 0;
 };

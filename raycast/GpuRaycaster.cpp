@@ -7,6 +7,7 @@
 
 #include "core/Error.h"
 #include "raycast/CpuRaycaster.h"
+#include "raycast/TiledCpuRaycaster.h"
 #include "gl/ShaderSource.h"
 
 namespace flipscope {
@@ -219,19 +220,20 @@ std::vector<RayHit> GpuRaycaster::readHits() {
 }
 
 std::unique_ptr<RaycastDevice> createRaycastDevice(DeviceChoice choice, std::string* fallbackReason) {
-  if (choice == DeviceChoice::Cpu) return std::make_unique<CpuRaycaster>();
+  if (choice == DeviceChoice::Cpu) return std::make_unique<TiledCpuRaycaster>();
+  if (choice == DeviceChoice::CpuReference) return std::make_unique<CpuRaycaster>();
   try {
     auto gpu = std::make_unique<GpuRaycaster>();
     if (choice == DeviceChoice::Auto && gpu->isSoftwareRenderer()) {
       if (fallbackReason)
-        *fallbackReason = "the OpenGL renderer is software (" + gpu->name() + "), slower than the CPU reference";
-      return std::make_unique<CpuRaycaster>();
+        *fallbackReason = "the OpenGL renderer is software (" + gpu->name() + "), slower than the CPU";
+      return std::make_unique<TiledCpuRaycaster>();
     }
     return gpu;
   } catch (const gl::Unavailable& e) {
     if (choice == DeviceChoice::Gpu) throw;
     if (fallbackReason) *fallbackReason = e.what();
-    return std::make_unique<CpuRaycaster>();
+    return std::make_unique<TiledCpuRaycaster>();
   }
 }
 

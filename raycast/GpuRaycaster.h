@@ -62,11 +62,12 @@ class GpuRaycaster : public RaycastDevice {
   bool mSoftware = false;  ///< Mesa llvmpipe/softpipe: timer queries return ~0, passes are timed on the wall clock
 };
 
-enum class DeviceChoice { Auto, Gpu, Cpu };
+enum class DeviceChoice { Auto, Gpu, Cpu, CpuReference };
 
 /// The device a command asked for: Gpu (OpenGL, llvmpipe included; throws gl::Unavailable
-/// without a context), Cpu (the reference ray-caster), or Auto (OpenGL on a hardware GPU, else
-/// the CPU reference, which beats llvmpipe by about 3x on two cores; `fallbackReason` says why).
+/// without a context), Cpu (TiledCpuRaycaster, the fast one), CpuReference (CpuRaycaster, the
+/// exact reference), or Auto (OpenGL on a hardware GPU, else the fast CPU ray-caster, which
+/// beats llvmpipe many times over; `fallbackReason` says why).
 std::unique_ptr<RaycastDevice> createRaycastDevice(DeviceChoice choice, std::string* fallbackReason = nullptr);
 
 }  // namespace flipscope

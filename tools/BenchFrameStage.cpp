@@ -42,6 +42,7 @@ void runStage(const FrameStageArgs& a) {
   if (a.request.spheres) {
     request.surface.smoothing.name = "none";
     request.surface.shading.mode = ShadingMode::Spheres;
+    request.settings.foam.mode = FoamMode::Keep;  // as the peer: every particle a sphere
   }
   const ResolvedRender look = resolve(request, store);
   FramePipeline pipeline(std::move(store), parseDeviceChoice("--device", a.request.device), look.settings,

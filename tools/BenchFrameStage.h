@@ -20,7 +20,8 @@ struct FrameStageRequest {
   int orbitFrames = 4;
   std::string device = "cpu";
   std::filesystem::path cameraFile;  ///< empty: `render`'s default camera, framed on the frame
-  /// The ray-caster's lit spheres only (--smoothing none --shading spheres), else `render`'s look.
+  /// The ray-caster's lit spheres of every particle only (--smoothing none --shading spheres
+  /// --foam keep), else `render`'s look.
   bool spheres = false;
 };
 

@@ -327,7 +327,7 @@ void addBenchRenderCommand(CLI::App& bench) {
   cmd->add_option("--orbit-frames", args->orbitFrames, "Warm frames timed")
       ->check(CLI::Range(1, 10000))
       ->capture_default_str();
-  cmd->add_option("--device", args->device, "auto, gpu or cpu")
+  cmd->add_option("--device", args->device, "auto, gpu, cpu or cpu-reference")
       ->check(CLI::IsMember({"auto", "gpu", "cpu"}))
       ->capture_default_str();
   cmd->add_option("--gpu-mem", args->gpuMem, "Brick pool budget")->capture_default_str();

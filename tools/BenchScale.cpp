@@ -139,7 +139,7 @@ void addBenchScaleCommand(CLI::App& bench) {
   cmd->add_option("--mem", args->mem, "--mem of the convert")->capture_default_str();
   cmd->add_option("--size", args->size, "Image size WxH")->capture_default_str();
   cmd->add_option("--orbit-frames", args->orbitFrames, "Warm frames of the orbit")->capture_default_str();
-  cmd->add_option("--device", args->device, "Render device: cpu, gpu or auto")->capture_default_str();
+  cmd->add_option("--device", args->device, "Render device: cpu, cpu-reference, gpu or auto")->capture_default_str();
   cmd->add_option("--work-dir", args->workDir,
                   "Where the raw frame, the store and the logs go (default: a temp directory); a frame of the same "
                   "--particles there is reused");

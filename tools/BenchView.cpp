@@ -20,7 +20,6 @@
 #include "pipeline/FramePipeline.h"
 #include "pipeline/RenderRequest.h"
 #include "preprocess/SynthFluid.h"
-#include "raycast/CpuRaycaster.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
 #include "tools/JsonOutput.h"
@@ -71,7 +70,7 @@ std::unique_ptr<FramePipeline> makePipeline(const std::shared_ptr<StoreBrickSour
   settings.radius = defaultSphereRadius(source->header(), settings.jitter);
   settings.readAheadFrames = readAhead;
   if (gpu) return std::make_unique<FramePipeline>(source, DeviceChoice::Gpu, settings, SurfaceSettings{});
-  return std::make_unique<FramePipeline>(source, std::make_unique<CpuRaycaster>(), settings, SurfaceSettings{});
+  return std::make_unique<FramePipeline>(source, DeviceChoice::Cpu, settings, SurfaceSettings{});
 }
 
 ViewRates measure(const fs::path& storeDir, bool gpu, const BenchViewArgs& a) {

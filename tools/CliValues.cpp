@@ -106,7 +106,8 @@ DeviceChoice parseDeviceChoice(const std::string& option, const std::string& tex
   if (text == "auto") return DeviceChoice::Auto;
   if (text == "gpu") return DeviceChoice::Gpu;
   if (text == "cpu") return DeviceChoice::Cpu;
-  bad(option, text, "auto, gpu or cpu");
+  if (text == "cpu-reference") return DeviceChoice::CpuReference;
+  bad(option, text, "auto, gpu, cpu or cpu-reference");
 }
 
 std::string describeKindCells(const std::array<std::uint64_t, kParticleKindCount>& cells) {

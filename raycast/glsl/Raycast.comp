@@ -39,6 +39,12 @@ void rcRequest(uint brickIndex) {
   }
 }
 
+// The brick march rcTrace runs is the shared one.
+RayHit rcTraceBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t, float tEnd);
+RayHit rcMarchBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t, float tEnd) {
+  return rcTraceBrick(result, slot, brick, eye, dir, t, tEnd);
+}
+
 #include "Raycast.glsl"
 
 void main() {

@@ -14,6 +14,10 @@
 //   uint  rcAttributeBase(uint slot, uint subBrick)  attribute index of the sub-brick's first set cell
 //   uint  rcAttribute(uint index)                 16-bit attribute value
 //   void  rcRequest(uint brickIndex)              asks for a brick (deduplicated by the includer)
+//   RayHit rcMarchBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t,
+//                       float tEnd)               the march through one resident brick that rcTrace
+//                                                 runs: rcTraceBrick, or an equivalent (the fast
+//                                                 CPU device's, raycast/TiledCpuRaycaster.cpp)
 //
 // Model. Every set cell of a bit-brick holds one sphere of radius P.sphere.x cells centred at the
 // cell centre plus the cell's jitter (§3.2.2). A sphere reaches cells at most k = P.brick.y away
@@ -155,13 +159,30 @@ FS_FUNC bool rcMipClear(uint slot, uint level, ivec3 cell) {
   return ((word >> (bit & 31u)) & 1u) == 0u;
 }
 
+// Empty-space skipping (§4.2): where the ray o + t d (invDir = 1 / d, brick-local cells) leaves
+// the coarsest clear mip block around brick-local `cell`, or -1 when the cell's level-1 block
+// is set (its spheres must be tested). A block's parent covers it, so once a level is set every
+// coarser one is too: walk up from level 1.
+FS_FUNC float rcClearBlockExit(uint slot, ivec3 cell, vec3 o, vec3 invDir) {
+  uint clearLevel = 0u;
+  for (uint level = 1u; level <= P.pool.w; level++) {
+    if (!rcMipClear(slot, level, cell)) break;
+    clearLevel = level;
+  }
+  if (clearLevel == 0u) return -1.0f;
+  int overlap = int(P.brick.x);
+  ivec3 size = ivec3(2 << clearLevel, 2 << clearLevel, 4 << clearLevel);
+  ivec3 s = cell + ivec3(overlap);  // >= 0; sizes are powers of two
+  ivec3 lo = (s & ~(size - ivec3(1))) - ivec3(overlap);
+  return max(rcBoxSpan(o, invDir, vec3(lo), vec3(lo + size)).y, 0.0f);
+}
+
 // Traces the segment [t, tEnd] of the ray through resident brick `brick` (at `slot`). Returns a
 // hit in `result` (status kRayHit) or leaves result.status pending; with kFoamVolume it adds the
 // foam in front of the hit (or of tEnd) to result.foam and returns as soon as rcFoamOpaque.
 FS_FUNC RayHit rcTraceBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t, float tEnd) {
   int B = int(P.grid.w);
   int k = int(P.brick.y);
-  uint levels = P.pool.w;
   float radius = P.sphere.x;
   float jitter = P.sphere.y;
   vec3 brickOrigin = vec3(brick * uvec3(uint(B)));
@@ -178,19 +199,9 @@ FS_FUNC RayHit rcTraceBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec
     if (t > tEnd) return result;
     vec3 p = o + t * dir;
     ivec3 cell = clamp(ivec3(floor(p)), ivec3(0), ivec3(B - 1));
-    // Empty-space skipping (§4.2): the coarsest clear block around the cell. A block's parent
-    // covers it, so once a level is set every coarser one is too: walk up from level 1.
-    uint clearLevel = 0u;
-    for (uint level = 1u; level <= levels; level++) {
-      if (!rcMipClear(slot, level, cell)) break;
-      clearLevel = level;
-    }
-    if (clearLevel > 0u) {
-      int overlap = int(P.brick.x);
-      ivec3 size = ivec3(2 << clearLevel, 2 << clearLevel, 4 << clearLevel);
-      ivec3 s = cell + ivec3(overlap);
-      ivec3 lo = ivec3((s.x / size.x) * size.x, (s.y / size.y) * size.y, (s.z / size.z) * size.z) - ivec3(overlap);
-      t = rcStepPast(rcBoxSpan(o, invDir, vec3(lo), vec3(lo + size)).y);
+    float clearExit = rcClearBlockExit(slot, cell, o, invDir);
+    if (clearExit >= 0.0f) {
+      t = rcStepPast(clearExit);
       continue;
     }
     // §3.3.1: ray-sphere tests against the jittered centres of the cells around this one.
@@ -273,6 +284,7 @@ struct ThicknessTrace {
 // P.sphere.z = 1 (best effort) bricks that are not resident count as empty.
 FS_FUNC ThicknessTrace rcThickness(vec3 eye, vec3 dir, float tHit) {
   int B = int(P.grid.w);
+  int brickShift = findLSB(P.grid.w);  // B is a power of two
   ivec3 gridCells = ivec3(int(P.grid.x), int(P.grid.y), int(P.grid.z)) * B;
   bool bestEffort = P.sphere.z > 0.5f;
   ivec3 current = ivec3(-1);
@@ -286,7 +298,7 @@ FS_FUNC ThicknessTrace rcThickness(vec3 eye, vec3 dir, float tHit) {
     if (cell.x < 0 || cell.y < 0 || cell.z < 0 || cell.x >= gridCells.x || cell.y >= gridCells.y ||
         cell.z >= gridCells.z)
       break;
-    ivec3 brick = cell / B;
+    ivec3 brick = cell >> brickShift;  // cell >= 0
     if (brick.x != current.x || brick.y != current.y || brick.z != current.z) {
       current = brick;
       uint index = rcBrickIndex(uvec3(brick));
@@ -360,7 +372,7 @@ FS_FUNC RayHit rcTrace(uvec2 pixel, RayHit ray) {
     vec3 lo = vec3(brick * uvec3(B));
     float brickExit = rcBoxSpan(eye, invDir, lo, lo + vec3(float(B))).y;
     result.status = kRayPending;
-    result = rcTraceBrick(result, slot, brick, eye, dir, t, brickExit);
+    result = rcMarchBrick(result, slot, brick, eye, dir, t, brickExit);
     if (rcFoamOpaque(result)) {
       result.status = kRayMiss;
       return result;

@@ -30,7 +30,7 @@ TEST(ColorByAttributeGl, EqualsTheCpuReference) {
   } catch (const gl::Unavailable& e) {
     FLIPSCOPE_SKIP_WITHOUT_GL(e.what());
   }
-  FramePipeline cpu(store, DeviceChoice::Cpu, ball.settings(), surface);
+  FramePipeline cpu(store, DeviceChoice::CpuReference, ball.settings(), surface);
   const FrameOutput a = gpu->render(0, ball.camera()), b = cpu.render(0, ball.camera());
   ASSERT_EQ(a.image.attribute.size(), b.image.attribute.size());
   int differentMask = 0, compared = 0;

@@ -26,7 +26,7 @@ TEST(FramePipelineGl, EqualsTheCpuReference) {
   } catch (const gl::Unavailable& e) {
     FLIPSCOPE_SKIP_WITHOUT_GL(e.what());
   }
-  FramePipeline cpu(store, DeviceChoice::Cpu, settings, SurfaceSettings{});
+  FramePipeline cpu(store, DeviceChoice::CpuReference, settings, SurfaceSettings{});
   Camera camera = ball.camera();
   camera.eye += glm::dvec3(40, 30, 0);  // an oblique view: silhouettes, grazing normals
   const FrameOutput a = gpu->render(0, camera), b = cpu.render(0, camera);

@@ -18,6 +18,7 @@
 #include "core/Error.h"
 #include "gl/EglContext.h"
 #include "raycast/CpuRaycaster.h"
+#include "raycast/TiledCpuRaycaster.h"
 #include "raycast/GpuRaycaster.h"
 #include "raycast/ImageWriter.h"
 #include "streaming/DelayedBrickSource.h"
@@ -217,8 +218,10 @@ void ViewerApp::buildPipeline() {
   std::unique_ptr<RaycastDevice> raycaster;
   if (mGpu)
     raycaster = std::make_unique<GpuRaycaster>(GpuRaycaster::AdoptCurrentContext{});
-  else
+  else if (mOptions.device == DeviceChoice::CpuReference)
     raycaster = std::make_unique<CpuRaycaster>();
+  else
+    raycaster = std::make_unique<TiledCpuRaycaster>();
   std::shared_ptr<BrickSource> source = mSource;
   if (mOptions.readDelayMs > 0)
     source = std::make_shared<DelayedBrickSource>(mSource, std::chrono::milliseconds(mOptions.readDelayMs));

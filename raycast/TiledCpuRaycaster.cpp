@@ -1,0 +1,207 @@
+#include "raycast/TiledCpuRaycaster.h"
+
+#include <array>
+#include <memory>
+#include <thread>
+
+#include <tbb/blocked_range2d.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include "raycast/CpuRaycastKernel.h"
+
+namespace flipscope {
+namespace {
+constexpr std::uint32_t kTileSize = 16;  ///< pixels per tile edge
+}  // namespace
+
+namespace glsl {
+namespace {
+
+/// The jitter offsets (§3.2.2, cellJitter) of the cells a thread's rays tested, direct-mapped
+/// by global cell, for one pass (one time step and jitter amplitude).
+class JitterCache {
+ public:
+  JitterCache(uint timeStep, float maxJitter) : mTimeStep(timeStep), mMaxJitter(maxJitter) {}
+
+  vec3 offset(uvec3 globalCell) {
+    // Global cells are below 2^20 per axis (Jitter.glsl), so the key is unique and never kEmpty.
+    const std::uint64_t key =
+        globalCell.x | (std::uint64_t(globalCell.y) << 21) | (std::uint64_t(globalCell.z) << 42);
+    Entry& entry = mEntries[(key * 0x9e3779b97f4a7c15ull) >> (64 - kIndexBits)];
+    if (entry.key != key) {
+      entry.key = key;
+      entry.offset = cellJitter(globalCell, mTimeStep, mMaxJitter);
+    }
+    return entry.offset;
+  }
+
+ private:
+  static constexpr int kIndexBits = 12;
+  static constexpr std::uint64_t kEmpty = ~std::uint64_t(0);
+  struct Entry {
+    std::uint64_t key = kEmpty;
+    vec3 offset{0.0f};
+  };
+  uint mTimeStep;
+  float mMaxJitter;
+  std::array<Entry, std::size_t(1) << kIndexBits> mEntries{};
+};
+
+/// Raycast.glsl with the brick march below in place of rcTraceBrick.
+struct TiledRaycastKernel : RaycastPoolAccess {
+  TiledRaycastKernel(const RaycastPoolAccess& access, JitterCache& jitter)
+      : RaycastPoolAccess(access),
+        jitter(&jitter),
+        B(int(P.grid.w)),
+        k(int(P.brick.y)),
+        overlap(int(P.brick.x)),
+        subBrickDims(bitBrickSubBrickDims(P.grid.w, P.brick.x)) {}
+
+  JitterCache* jitter;
+  int B, k, overlap;
+  uvec3 subBrickDims;
+
+  /// The nearest sphere hit of the march so far.
+  struct Nearest {
+    float t = 3.0e38f;
+    ivec3 cell{0};
+    vec3 normal{0.0f};
+  };
+
+  /// Tests the sphere of brick-local cell (x, y, z) (in [-n, B + n)) of the slot whose bits
+  /// (and foam bits, or null) are given, if it holds one, against the ray through brick-local
+  /// point p = o + t dir (§3.3.1, as rcTraceBrick). Scalars throughout: this is the inner loop.
+  [[gnu::always_inline]] void testCell(Nearest& nearest, const uvec4* bits, const uvec4* foam, uvec3 brickCell,
+                                       int x, int y, int z, vec3 p, float t, vec3 dir) {
+    const uint sx = uint(x + overlap), sy = uint(y + overlap), sz = uint(z + overlap);
+    const uint subBrick = (sx >> 2u) + subBrickDims.x * ((sy >> 2u) + subBrickDims.y * (sz >> 3u));
+    const uint bit = (sx & 3u) | ((sy & 3u) << 2u) | ((sz & 7u) << 4u);
+    const uint* words = &bits[subBrick].x;
+    uint word = words[bit >> 5u];
+    if (foam) word &= ~(&foam[subBrick].x)[bit >> 5u];
+    if (((word >> (bit & 31u)) & 1u) == 0u) return;
+    vec3 centre = vec3(float(x) + 0.5f, float(y) + 0.5f, float(z) + 0.5f);
+    if (P.sphere.y > 0.0f) centre += jitter->offset(brickCell + uvec3(uint(x), uint(y), uint(z)));
+    const vec3 oc = p - centre;
+    const float b = dot(oc, dir);
+    const float c = dot(oc, oc) - P.sphere.x * P.sphere.x;
+    const float disc = b * b - c;
+    if (disc < 0.0f) return;
+    const float local = -b - std::sqrt(disc);
+    const float tHit = t + local;
+    if (tHit >= 0.0f && tHit < nearest.t) {
+      nearest.t = tHit;
+      nearest.cell = ivec3(x, y, z);
+      nearest.normal = (oc + local * dir) / P.sphere.x;
+    }
+  }
+
+  /// rcTraceBrick's contract and result: the segment [t, tEnd] of the ray through the resident
+  /// brick `brick` at `slot`, front to back, a 3D DDA from cell to cell. The first cell, and the
+  /// first after a skipped clear mip block, tests its whole (2k+1)^3 neighbourhood; a step
+  /// along an axis tests the slab that enters it. The DDA's state is kept in scalar arrays (a
+  /// vector indexed by a run-time axis goes through memory).
+  RayHit rcMarchBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t, float tEnd) {
+    const uvec3 brickCell = brick * uvec3(uint(B));
+    const vec3 o = eye - vec3(brickCell);
+    const vec3 invDir = rcSafeInverse(dir);
+    const std::size_t first = std::size_t(slot) * P.brick.w;
+    const uvec4* bits = pool->subBricks.data() + first;
+    const uvec4* foam = (P.foam.x & kFoamSkip) != 0u ? pool->foamBits.data() + first : nullptr;
+    const bool foamVolume = (P.foam.x & kFoamVolume) != 0u;
+    const float origin[3] = {o.x, o.y, o.z};
+    const float inverse[3] = {invDir.x, invDir.y, invDir.z};
+    const int step[3] = {dir.x < 0.0f ? -1 : 1, dir.y < 0.0f ? -1 : 1, dir.z < 0.0f ? -1 : 1};
+    Nearest nearest;
+    int cell[3] = {0, 0, 0};
+    float exit[3] = {0.0f, 0.0f, 0.0f};  // where the ray leaves the cell across each axis's far plane
+    bool located = false;
+    auto planeExit = [&](int axis) {
+      return (float(cell[axis] + (step[axis] > 0 ? 1 : 0)) - origin[axis]) * inverse[axis];
+    };
+    for (uint n = 0u; n < kRaycastMaxSteps; n++) {
+      int axis = -1;  // the axis of the DDA step into this cell; -1 when located afresh
+      if (located) {
+        axis = exit[0] <= exit[1] ? (exit[0] <= exit[2] ? 0 : 2) : (exit[1] <= exit[2] ? 1 : 2);
+        t = rcStepPast(exit[axis]);
+        cell[axis] += step[axis];
+        if (t > tEnd || cell[axis] < 0 || cell[axis] >= B) return result;
+      } else {
+        if (t > tEnd) return result;
+        const ivec3 c = clamp(ivec3(floor(o + t * dir)), ivec3(0), ivec3(B - 1));
+        cell[0] = c.x;
+        cell[1] = c.y;
+        cell[2] = c.z;
+      }
+      const float clearExit = rcClearBlockExit(slot, ivec3(cell[0], cell[1], cell[2]), o, invDir);
+      if (clearExit >= 0.0f) {
+        t = rcStepPast(clearExit);
+        located = false;
+        continue;
+      }
+      const vec3 p = o + t * dir;
+      if (axis < 0) {
+        for (int a = 0; a < 3; a++) exit[a] = planeExit(a);
+        for (int z = cell[2] - k; z <= cell[2] + k; z++)
+          for (int y = cell[1] - k; y <= cell[1] + k; y++)
+            for (int x = cell[0] - k; x <= cell[0] + k; x++) testCell(nearest, bits, foam, brickCell, x, y, z, p, t, dir);
+        located = true;
+      } else {
+        exit[axis] = planeExit(axis);
+        const int slab = cell[axis] + step[axis] * k;
+        if (axis == 0) {
+          for (int z = cell[2] - k; z <= cell[2] + k; z++)
+            for (int y = cell[1] - k; y <= cell[1] + k; y++) testCell(nearest, bits, foam, brickCell, slab, y, z, p, t, dir);
+        } else if (axis == 1) {
+          for (int z = cell[2] - k; z <= cell[2] + k; z++)
+            for (int x = cell[0] - k; x <= cell[0] + k; x++) testCell(nearest, bits, foam, brickCell, x, slab, z, p, t, dir);
+        } else {
+          for (int y = cell[1] - k; y <= cell[1] + k; y++)
+            for (int x = cell[0] - k; x <= cell[0] + k; x++) testCell(nearest, bits, foam, brickCell, x, y, slab, p, t, dir);
+        }
+      }
+      const float cellExit = std::min(std::min(exit[0], exit[1]), exit[2]);
+      if (foamVolume) {
+        result.foam = rcAccumulateFoam(result.foam, slot, o, dir, t, min(cellExit, nearest.t));
+        if (rcFoamOpaque(result)) return result;
+      }
+      if (nearest.t <= cellExit) {
+        result.normal = vec4(normalize(nearest.normal), rcCellAttribute(slot, nearest.cell));
+        result.t = nearest.t;
+        result.status = kRayHit;
+        return result;
+      }
+    }
+    return result;
+  }
+
+#include "raycast/glsl/Raycast.glsl"
+};
+
+}  // namespace
+}  // namespace glsl
+
+std::string TiledCpuRaycaster::name() const {
+  return "CPU (" + std::to_string(std::thread::hardware_concurrency()) + " threads)";
+}
+
+std::vector<std::uint32_t> TiledCpuRaycaster::trace(const RaycastParams& params) {
+  return timedPass(params, [&](const glsl::RaycastPoolAccess& access) {
+    tbb::enumerable_thread_specific<std::unique_ptr<glsl::JitterCache>> caches;
+    const tbb::blocked_range2d<std::uint32_t> tiles(0, mHeight, kTileSize, 0, mWidth, kTileSize);
+    tbb::parallel_for(tiles, [&](const tbb::blocked_range2d<std::uint32_t>& tile) {
+      auto& cache = caches.local();
+      if (!cache) cache = std::make_unique<glsl::JitterCache>(params.image.z, params.sphere.y);
+      glsl::TiledRaycastKernel kernel(access, *cache);
+      for (std::uint32_t y = tile.rows().begin(); y != tile.rows().end(); ++y) {
+        for (std::uint32_t x = tile.cols().begin(); x != tile.cols().end(); ++x) {
+          RayHit& ray = mHits[std::size_t(y) * mWidth + x];
+          if (kernel.rcNeedsPass(ray)) ray = kernel.rcPass(glm::uvec2(x, y), ray);
+        }
+      }
+    });
+  });
+}
+
+}  // namespace flipscope
