@@ -154,7 +154,7 @@ void FramePipeline::init(std::shared_ptr<BrickSource> source,
 
 FramePipeline::~FramePipeline() = default;
 
-std::string FramePipeline::deviceName() const { return mScreen->name(); }
+std::string FramePipeline::deviceName() const { return mRenderer->device().name(); }
 
 ScreenFrame FramePipeline::screenFrame(const Camera& camera) const {
   const RenderSettings& settings = mRenderer->settings();

@@ -109,7 +109,7 @@ class FramePipeline {
 
   FrameRenderer& renderer() { return *mRenderer; }
   const FrameRenderer& renderer() const { return *mRenderer; }
-  /// The ray-caster's device and the screen stages' ("OpenGL (device): ..." or "CPU reference").
+  /// The ray-caster's device ("OpenGL (device): ...", "CPU (2 threads)" or "CPU reference (2 threads)").
   std::string deviceName() const;
   /// The frame block of `camera` for this pipeline's image size, radius and up axis.
   ScreenFrame screenFrame(const Camera& camera) const;

@@ -89,9 +89,9 @@ FS_FUNC uvec2 rcHalfBlock(ivec3 block) {
   return uvec2(bitBrickSubBrickLinear(uvec3(b.x, b.y, b.z >> 1u), dims), b.z & 1u);
 }
 
-// Density (0..1) of the sphere cells in the 4^3 block holding brick-local point `p` (§3.6).
-FS_FUNC float rcLiquidDensity(uint slot, vec3 p) {
-  uvec2 h = rcHalfBlock(ivec3(floor((p + vec3(float(P.brick.x))) * 0.25f)));
+// Density (0..1) of the sphere cells in the 4^3 block holding brick-local `cell` (§3.6).
+FS_FUNC float rcLiquidDensity(uint slot, ivec3 cell) {
+  uvec2 h = rcHalfBlock((cell + ivec3(int(P.brick.x))) >> 2);
   uvec4 bits = rcSubBrick(slot, h.x);
   if ((P.foam.x & kFoamSkip) != 0u) bits = bits & ~rcFoamSubBrick(slot, h.x);
   return float(bitBrickHalfCount(bits, h.y)) / 64.0f;
@@ -308,7 +308,7 @@ FS_FUNC ThicknessTrace rcThickness(vec3 eye, vec3 dir, float tHit) {
         return trace;
       }
     }
-    if (slot != kNotResident) trace.cells += rcLiquidDensity(slot, p - vec3(brick * B)) * float(kThicknessStep);
+    if (slot != kNotResident) trace.cells += rcLiquidDensity(slot, cell - brick * B) * float(kThicknessStep);
   }
   return trace;
 }
