@@ -328,7 +328,7 @@ void addBenchRenderCommand(CLI::App& bench) {
       ->check(CLI::Range(1, 10000))
       ->capture_default_str();
   cmd->add_option("--device", args->device, "auto, gpu, cpu or cpu-reference")
-      ->check(CLI::IsMember({"auto", "gpu", "cpu"}))
+      ->check(CLI::IsMember({"auto", "gpu", "cpu", "cpu-reference"}))
       ->capture_default_str();
   cmd->add_option("--gpu-mem", args->gpuMem, "Brick pool budget")->capture_default_str();
   cmd->add_flag("--no-vdb-tool", args->skipVdbTool, "Skip the vdb_tool comparison");

@@ -71,7 +71,7 @@ void addDemoCommand(CLI::App& app) {
   cmd->add_option("--frames", args->frames, "Frames to generate")->check(CLI::Range(1, 1000))->capture_default_str();
   cmd->add_option("--size", args->size, "Preview image size WxH")->capture_default_str();
   cmd->add_option("--device", args->device, "auto, gpu, cpu or cpu-reference")
-      ->check(CLI::IsMember({"auto", "gpu", "cpu"}))
+      ->check(CLI::IsMember({"auto", "gpu", "cpu", "cpu-reference"}))
       ->capture_default_str();
   cmd->callback([args] { runDemo(*args); });
 }

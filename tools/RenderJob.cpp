@@ -48,7 +48,7 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
   FramePipeline pipeline(store, job.device, settings, surface, &fallback);
   FrameRenderer& renderer = pipeline.renderer();
   if (!job.quiet) {
-    if (!fallback.empty()) std::fprintf(stderr, "render: using the CPU reference: %s\n", fallback.c_str());
+    if (!fallback.empty()) std::fprintf(stderr, "render: using the CPU ray-caster: %s\n", fallback.c_str());
     const SmoothingOptions& smoothing = resolve(surface.smoothing);
     std::printf("render: %s; sphere radius %.3g cells%s; smoothing %s (%d iterations, strength %g)\n",
                 pipeline.deviceName().c_str(), settings.radius,

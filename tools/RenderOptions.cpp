@@ -148,7 +148,7 @@ void addRenderLookOptions(CLI::App& command, RenderLookArgs& a) {
   cmd->add_option("--gpu-mem", args->gpuMem, "Brick pool budget on the device")->capture_default_str();
   cmd->add_option("--cpu-mem", args->cpuMem, "Converted-brick cache in CPU memory")->capture_default_str();
   cmd->add_option("--device", args->device, "auto: OpenGL through EGL on a hardware GPU, else the CPU; gpu; cpu; cpu-reference (the exact, slower CPU ray-caster)")
-      ->check(CLI::IsMember({"auto", "gpu", "cpu"}))
+      ->check(CLI::IsMember({"auto", "gpu", "cpu", "cpu-reference"}))
       ->capture_default_str();
   cmd->add_option("--max-passes", args->maxPasses, "Ray-casting passes per frame at most")->capture_default_str();
 }
