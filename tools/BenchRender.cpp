@@ -143,8 +143,11 @@ struct PeerComparison {
   }
 };
 
+/// The Embree peer beside flipscope on `device`: the bench's --device when it names a CPU
+/// ray-caster (cpu or cpu-reference), else cpu, since Embree runs on the CPU.
 PeerComparison compareWithEmbree(const fs::path& work, const fs::path& particles, double cellSize,
-                                 const Camera& camera, const std::string& size, int orbitFrames) {
+                                 const Camera& camera, const std::string& size, int orbitFrames,
+                                 const std::string& device) {
   PeerComparison c;
   c.size = size;
   const fs::path store = work / "peer.store", cameraFile = work / "peer_camera.json";
@@ -160,7 +163,7 @@ PeerComparison compareWithEmbree(const fs::path& work, const fs::path& particles
   frame.store = store;
   frame.size = size;
   frame.orbitFrames = orbitFrames;
-  frame.device = "cpu";
+  frame.device = device == "cpu-reference" ? device : "cpu";
   frame.cameraFile = cameraFile;
   frame.spheres = true;
   c.flipscope = runFrameStage(frame, work, "peer_flipscope");
@@ -256,7 +259,7 @@ void runBenchRender(const BenchRenderArgs& a) {
   if (!a.peer.empty()) {
     if (!a.json) std::fprintf(stderr, "bench render: the Embree peer at %ux%u ...\n", vw, vh);
     peer = compareWithEmbree(work, ply, fluid.cellSize(), lastCamera, std::to_string(vw) + "x" + std::to_string(vh),
-                             a.orbitFrames);
+                             a.orbitFrames, a.device);
   }
 
   const SizeResult& main = results.back();
