@@ -8,14 +8,15 @@
 namespace flipscope {
 
 std::uint64_t PoolLayout::slotBytes() const {
-  return std::uint64_t(subBricksPerSlot) * (16 + (attributes ? 4 : 0) + (foam ? 16 : 0)) +
+  return std::uint64_t(subBricksPerSlot) * (16 + (attributes ? 4 : 0) + (foam ? 16 : 0) + (halfCounts ? 4 : 0)) +
          std::uint64_t(mipWordsPerSlot + (foam ? foamOccupancyWords() : 0)) * 4;
 }
 
 PoolLayout PoolLayout::forBudget(std::uint32_t brickSize, std::uint32_t overlap, bool attributes,
-                                 std::uint64_t budgetBytes, bool foam) {
+                                 std::uint64_t budgetBytes, bool foam, bool halfCounts) {
   PoolLayout layout;
   layout.foam = foam;
+  layout.halfCounts = halfCounts;
   layout.brickSize = brickSize;
   layout.overlap = overlap;
   const glm::uvec3 dims = bitBrickSubBrickDims(brickSize, overlap);

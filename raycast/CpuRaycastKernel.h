@@ -37,8 +37,10 @@ struct RaycastPoolAccess {
   }
 };
 
-/// The reference: Raycast.glsl with its own brick march.
+/// The reference: Raycast.glsl with its own brick march and half block counts.
 struct RaycastKernel : RaycastPoolAccess {
+  uint rcLiquidHalfCount(uint slot, uvec2 h) { return rcLiquidHalfCountOfBits(slot, h); }
+  uint rcFoamHalfCount(uint slot, uvec2 h) { return rcFoamHalfCountOfBits(slot, h); }
   RayHit rcMarchBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t, float tEnd) {
     return rcTraceBrick(result, slot, brick, eye, dir, t, tEnd);
   }

@@ -41,6 +41,8 @@ void CpuRaycaster::allocatePool(const PoolLayout& layout) {
   mPool.foamBits.resize(layout.foam ? std::size_t(layout.slots) * layout.subBricksPerSlot : 0);
   mPool.foamOccupancy.clear();
   mPool.foamOccupancy.resize(layout.foam ? std::size_t(layout.slots) * layout.foamOccupancyWords() : 0);
+  mPool.halfCounts.clear();
+  mPool.halfCounts.resize(layout.halfCounts ? std::size_t(layout.slots) * layout.subBricksPerSlot * 4 : 0);
 }
 
 void CpuRaycaster::setOctree(std::span<const OctreeNode> nodes) {

@@ -45,6 +45,9 @@ class CpuRaycaster : public RaycastDevice {
     UninitializedVector<std::uint16_t> attributes;
     UninitializedVector<glm::uvec4> foamBits;  ///< with a foam pool: per slot, as subBricks
     UninitializedVector<std::uint32_t> foamOccupancy;  ///< per slot, PoolLayout::foamOccupancyWords
+    /// With PoolLayout::halfCounts: per slot and sub-brick, the sphere cells of its lower and
+    /// upper half (rcLiquidHalfCountOfBits), then its foam cells (rcFoamHalfCountOfBits).
+    UninitializedVector<std::uint8_t> halfCounts;
   };
   const Pool& pool() const { return mPool; }
 

@@ -81,13 +81,15 @@ StreamerOptions streamerOptions(const StoreHeader& header, const RenderSettings&
 }
 
 /// The pool within the budget, shrunk until its largest buffer (the bits) fits the device.
-PoolLayout poolLayout(const StoreHeader& header, const RenderSettings& settings, std::uint64_t maxBufferBytes) {
+PoolLayout poolLayout(const StoreHeader& header, const RenderSettings& settings, const RaycastDevice& device) {
+  const std::uint64_t maxBufferBytes = device.maxBufferBytes();
   validate(settings);
   const bool attributes = header.attribute != AttributeKind::None;
   const bool foam = settings.foam.mode != FoamMode::Keep;
   std::uint64_t budget = settings.gpuBudgetBytes;
   for (;;) {
-    PoolLayout layout = PoolLayout::forBudget(header.brickSize, storedOverlap(settings), attributes, budget, foam);
+    PoolLayout layout = PoolLayout::forBudget(header.brickSize, storedOverlap(settings), attributes, budget, foam,
+                                              device.keepsHalfCounts());
     const std::uint64_t bits = std::uint64_t(layout.slots) * layout.subBricksPerSlot * 16;
     const std::uint64_t ring = layout.attributeCapacity * 2;
     if (bits <= maxBufferBytes && ring <= maxBufferBytes) return layout;
@@ -110,7 +112,7 @@ FrameRenderer::FrameRenderer(std::shared_ptr<BrickSource> source, std::unique_pt
       mSettings(settings),
       mReach(sphereReach(settings.radius, settings.jitter)),
       mOverlap(storedOverlap(settings)),
-      mPool(poolLayout(mSource->header(), settings, mDevice->maxBufferBytes())) {
+      mPool(poolLayout(mSource->header(), settings, *mDevice)) {
   mDevice->allocatePool(mPool.layout());
   mStreamer = std::make_unique<Streamer>(mSource, streamerOptions(mSource->header(), settings, mReach));
 }

@@ -8,6 +8,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include "core/Error.h"
 #include "raycast/CpuRaycastKernel.h"
 
 namespace flipscope {
@@ -61,6 +62,17 @@ struct TiledRaycastKernel : RaycastPoolAccess {
   JitterCache* jitter;
   int B, k, overlap;
   uvec3 subBrickDims;
+
+  /// The half counts Raycast.glsl reads, from the pool's table (Pool::halfCounts), which holds
+  /// the sphere cells without the foam cells whenever the pool has foam (FrameRenderer sets
+  /// kFoamSkip then).
+  uint rcLiquidHalfCount(uint slot, uvec2 h) {
+    if (pool->layout.foam && (P.foam.x & kFoamSkip) == 0u) return rcLiquidHalfCountOfBits(slot, h);
+    return pool->halfCounts[(std::size_t(slot) * P.brick.w + h.x) * 4u + h.y];
+  }
+  uint rcFoamHalfCount(uint slot, uvec2 h) {
+    return pool->halfCounts[(std::size_t(slot) * P.brick.w + h.x) * 4u + 2u + h.y];
+  }
 
   /// The nearest sphere hit of the march so far.
   struct Nearest {
@@ -184,6 +196,31 @@ struct TiledRaycastKernel : RaycastPoolAccess {
 
 std::string TiledCpuRaycaster::name() const {
   return "CPU (" + std::to_string(std::thread::hardware_concurrency()) + " threads)";
+}
+
+void TiledCpuRaycaster::countHalves(std::uint32_t slot) {
+  const PoolLayout& layout = mPool.layout;
+  FLIPSCOPE_CHECK(layout.halfCounts && slot < layout.slots);
+  const std::size_t first = std::size_t(slot) * layout.subBricksPerSlot;
+  for (std::size_t s = first; s < first + layout.subBricksPerSlot; ++s) {
+    const glm::uvec4 foam = layout.foam ? mPool.foamBits[s] : glm::uvec4(0);
+    const glm::uvec4 liquid = mPool.subBricks[s] & ~foam;
+    std::uint8_t* counts = &mPool.halfCounts[s * 4];
+    for (std::uint32_t upper = 0; upper < 2; ++upper) {
+      counts[upper] = std::uint8_t(bitBrickHalfCount(liquid, upper));
+      counts[2 + upper] = std::uint8_t(bitBrickHalfCount(foam, upper));
+    }
+  }
+}
+
+void TiledCpuRaycaster::uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset, const ConvertedBrick& brick) {
+  CpuRaycaster::uploadBrick(slot, attributeOffset, brick);
+  countHalves(slot);
+}
+
+void TiledCpuRaycaster::classifyFoam(std::span<const std::uint32_t> slots, const FoamClassifyParams& params) {
+  CpuRaycaster::classifyFoam(slots, params);
+  tbb::parallel_for(std::size_t(0), slots.size(), [&](std::size_t i) { countHalves(slots[i]); });
 }
 
 std::vector<std::uint32_t> TiledCpuRaycaster::trace(const RaycastParams& params) {

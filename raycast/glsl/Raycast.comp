@@ -39,7 +39,11 @@ void rcRequest(uint brickIndex) {
   }
 }
 
-// The brick march rcTrace runs is the shared one.
+// The brick march rcTrace runs and the half block counts are the shared ones.
+uint rcLiquidHalfCountOfBits(uint slot, uvec2 h);
+uint rcFoamHalfCountOfBits(uint slot, uvec2 h);
+uint rcLiquidHalfCount(uint slot, uvec2 h) { return rcLiquidHalfCountOfBits(slot, h); }
+uint rcFoamHalfCount(uint slot, uvec2 h) { return rcFoamHalfCountOfBits(slot, h); }
 RayHit rcTraceBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t, float tEnd);
 RayHit rcMarchBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t, float tEnd) {
   return rcTraceBrick(result, slot, brick, eye, dir, t, tEnd);

@@ -14,6 +14,9 @@
 //   uint  rcAttributeBase(uint slot, uint subBrick)  attribute index of the sub-brick's first set cell
 //   uint  rcAttribute(uint index)                 16-bit attribute value
 //   void  rcRequest(uint brickIndex)              asks for a brick (deduplicated by the includer)
+//   uint  rcLiquidHalfCount(uint slot, uvec2 h)   sphere cells of half block h (rcHalfBlock) of a
+//   uint  rcFoamHalfCount(uint slot, uvec2 h)     slot, and its foam cells: rcLiquidHalfCountOfBits
+//                                                 and rcFoamHalfCountOfBits, or a table of them
 //   RayHit rcMarchBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t,
 //                       float tEnd)               the march through one resident brick that rcTrace
 //                                                 runs: rcTraceBrick, or an equivalent (the fast
@@ -89,12 +92,19 @@ FS_FUNC uvec2 rcHalfBlock(ivec3 block) {
   return uvec2(bitBrickSubBrickLinear(uvec3(b.x, b.y, b.z >> 1u), dims), b.z & 1u);
 }
 
-// Density (0..1) of the sphere cells in the 4^3 block holding brick-local `cell` (§3.6).
-FS_FUNC float rcLiquidDensity(uint slot, ivec3 cell) {
-  uvec2 h = rcHalfBlock((cell + ivec3(int(P.brick.x))) >> 2);
+// The sphere cells (set, and not foam with kFoamSkip) of half block `h` (rcHalfBlock) of a slot.
+FS_FUNC uint rcLiquidHalfCountOfBits(uint slot, uvec2 h) {
   uvec4 bits = rcSubBrick(slot, h.x);
   if ((P.foam.x & kFoamSkip) != 0u) bits = bits & ~rcFoamSubBrick(slot, h.x);
-  return float(bitBrickHalfCount(bits, h.y)) / 64.0f;
+  return bitBrickHalfCount(bits, h.y);
+}
+
+// The foam cells of half block `h` of a slot's foam bit-brick.
+FS_FUNC uint rcFoamHalfCountOfBits(uint slot, uvec2 h) { return bitBrickHalfCount(rcFoamSubBrick(slot, h.x), h.y); }
+
+// Density (0..1) of the sphere cells in the 4^3 block holding brick-local `cell` (§3.6).
+FS_FUNC float rcLiquidDensity(uint slot, ivec3 cell) {
+  return float(rcLiquidHalfCount(slot, rcHalfBlock((cell + ivec3(int(P.brick.x))) >> 2))) / 64.0f;
 }
 
 // Foam density (0..1) at brick-local point `p`: trilinear between the centres of the 4^3 blocks
@@ -107,9 +117,8 @@ FS_FUNC float rcFoamDensity(uint slot, vec3 p) {
   float density = 0.0f;
   for (int i = 0; i < 8; i++) {
     ivec3 o = ivec3(i & 1, (i >> 1) & 1, i >> 2);
-    uvec2 h = rcHalfBlock(b + o);
     float weight = (o.x == 1 ? w.x : 1.0f - w.x) * (o.y == 1 ? w.y : 1.0f - w.y) * (o.z == 1 ? w.z : 1.0f - w.z);
-    density += weight * float(bitBrickHalfCount(rcFoamSubBrick(slot, h.x), h.y));
+    density += weight * float(rcFoamHalfCount(slot, rcHalfBlock(b + o)));
   }
   return density / 64.0f;
 }
