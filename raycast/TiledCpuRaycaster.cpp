@@ -26,9 +26,12 @@ class JitterCache {
   JitterCache(uint timeStep, float maxJitter) : mTimeStep(timeStep), mMaxJitter(maxJitter) {}
 
   vec3 offset(uvec3 globalCell) {
-    // Global cells are below 2^20 per axis (Jitter.glsl), so the key is unique and never kEmpty.
-    const std::uint64_t key =
-        globalCell.x | (std::uint64_t(globalCell.y) << 21) | (std::uint64_t(globalCell.z) << 42);
+    // Global cells are below 2^20 per axis (Jitter.glsl); a border cell left of the grid's
+    // origin comes as a wrapped negative (as in rcTraceBrick). 21 bits per axis keep both
+    // apart, and the key below 2^63 is never kEmpty.
+    constexpr std::uint64_t kAxis = (std::uint64_t(1) << 21) - 1;
+    const std::uint64_t key = (globalCell.x & kAxis) | ((std::uint64_t(globalCell.y) & kAxis) << 21) |
+                              ((std::uint64_t(globalCell.z) & kAxis) << 42);
     Entry& entry = mEntries[(key * 0x9e3779b97f4a7c15ull) >> (64 - kIndexBits)];
     if (entry.key != key) {
       entry.key = key;
