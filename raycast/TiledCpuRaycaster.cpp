@@ -1,7 +1,6 @@
 #include "raycast/TiledCpuRaycaster.h"
 
 #include <array>
-#include <memory>
 #include <thread>
 
 #include <tbb/blocked_range2d.h>
@@ -52,8 +51,11 @@ class JitterCache {
   std::array<Entry, std::size_t(1) << kIndexBits> mEntries{};
 };
 
-/// Raycast.glsl with the brick march below in place of rcTraceBrick.
+/// Raycast.glsl with the brick march below in place of rcTraceBrick. The shared code comes
+/// first, so that its types (NearestSphere) name this struct's parameters.
 struct TiledRaycastKernel : RaycastPoolAccess {
+#include "raycast/glsl/Raycast.glsl"
+
   TiledRaycastKernel(const RaycastPoolAccess& access, JitterCache& jitter)
       : RaycastPoolAccess(access),
         jitter(&jitter),
@@ -77,39 +79,21 @@ struct TiledRaycastKernel : RaycastPoolAccess {
     return pool->halfCounts[(std::size_t(slot) * P.brick.w + h.x) * 4u + 2u + h.y];
   }
 
-  /// The nearest sphere hit of the march so far.
-  struct Nearest {
-    float t = 3.0e38f;
-    ivec3 cell{0};
-    vec3 normal{0.0f};
-  };
-
   /// Tests the sphere of brick-local cell (x, y, z) (in [-n, B + n)) of the slot whose bits
   /// (and foam bits, or null) are given, if it holds one, against the ray through brick-local
-  /// point p = o + t dir (§3.3.1, as rcTraceBrick). Scalars throughout: this is the inner loop.
-  [[gnu::always_inline]] void testCell(Nearest& nearest, const uvec4* bits, const uvec4* foam, uvec3 brickCell,
+  /// point p = o + t dir (rcNearerSphere, as rcTraceBrick). The cell's bit is read straight from
+  /// the sub-brick, with scalars: this is the inner loop.
+  [[gnu::always_inline]] void testCell(NearestSphere& nearest, const uvec4* bits, const uvec4* foam, uvec3 brickCell,
                                        int x, int y, int z, vec3 p, float t, vec3 dir) {
     const uint sx = uint(x + overlap), sy = uint(y + overlap), sz = uint(z + overlap);
     const uint subBrick = (sx >> 2u) + subBrickDims.x * ((sy >> 2u) + subBrickDims.y * (sz >> 3u));
     const uint bit = (sx & 3u) | ((sy & 3u) << 2u) | ((sz & 7u) << 4u);
-    const uint* words = &bits[subBrick].x;
-    uint word = words[bit >> 5u];
+    uint word = (&bits[subBrick].x)[bit >> 5u];
     if (foam) word &= ~(&foam[subBrick].x)[bit >> 5u];
     if (((word >> (bit & 31u)) & 1u) == 0u) return;
     vec3 centre = vec3(float(x) + 0.5f, float(y) + 0.5f, float(z) + 0.5f);
     if (P.sphere.y > 0.0f) centre += jitter->offset(brickCell + uvec3(uint(x), uint(y), uint(z)));
-    const vec3 oc = p - centre;
-    const float b = dot(oc, dir);
-    const float c = dot(oc, oc) - P.sphere.x * P.sphere.x;
-    const float disc = b * b - c;
-    if (disc < 0.0f) return;
-    const float local = -b - std::sqrt(disc);
-    const float tHit = t + local;
-    if (tHit >= 0.0f && tHit < nearest.t) {
-      nearest.t = tHit;
-      nearest.cell = ivec3(x, y, z);
-      nearest.normal = (oc + local * dir) / P.sphere.x;
-    }
+    nearest = rcNearerSphere(nearest, ivec3(x, y, z), centre, p, t, dir);
   }
 
   /// rcTraceBrick's contract and result: the segment [t, tEnd] of the ray through the resident
@@ -124,11 +108,10 @@ struct TiledRaycastKernel : RaycastPoolAccess {
     const std::size_t first = std::size_t(slot) * P.brick.w;
     const uvec4* bits = pool->subBricks.data() + first;
     const uvec4* foam = (P.foam.x & kFoamSkip) != 0u ? pool->foamBits.data() + first : nullptr;
-    const bool foamVolume = (P.foam.x & kFoamVolume) != 0u;
     const float origin[3] = {o.x, o.y, o.z};
     const float inverse[3] = {invDir.x, invDir.y, invDir.z};
     const int step[3] = {dir.x < 0.0f ? -1 : 1, dir.y < 0.0f ? -1 : 1, dir.z < 0.0f ? -1 : 1};
-    Nearest nearest;
+    NearestSphere nearest = rcNoSphere();
     int cell[3] = {0, 0, 0};
     float exit[3] = {0.0f, 0.0f, 0.0f};  // where the ray leaves the cell across each axis's far plane
     bool located = false;
@@ -177,21 +160,14 @@ struct TiledRaycastKernel : RaycastPoolAccess {
         }
       }
       const float cellExit = std::min(std::min(exit[0], exit[1]), exit[2]);
-      if (foamVolume) {
+      if ((P.foam.x & kFoamVolume) != 0u) {
         result.foam = rcAccumulateFoam(result.foam, slot, o, dir, t, min(cellExit, nearest.t));
         if (rcFoamOpaque(result)) return result;
       }
-      if (nearest.t <= cellExit) {
-        result.normal = vec4(normalize(nearest.normal), rcCellAttribute(slot, nearest.cell));
-        result.t = nearest.t;
-        result.status = kRayHit;
-        return result;
-      }
+      if (nearest.t <= cellExit) return rcSphereHit(result, slot, nearest);
     }
     return result;
   }
-
-#include "raycast/glsl/Raycast.glsl"
 };
 
 }  // namespace
@@ -218,7 +194,8 @@ void TiledCpuRaycaster::countHalves(std::uint32_t slot) {
 
 void TiledCpuRaycaster::uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset, const ConvertedBrick& brick) {
   CpuRaycaster::uploadBrick(slot, attributeOffset, brick);
-  countHalves(slot);
+  // A foam pool's upload is classified (and counted there) before the next trace.
+  if (!mPool.layout.foam) countHalves(slot);
 }
 
 void TiledCpuRaycaster::classifyFoam(std::span<const std::uint32_t> slots, const FoamClassifyParams& params) {
@@ -228,12 +205,10 @@ void TiledCpuRaycaster::classifyFoam(std::span<const std::uint32_t> slots, const
 
 std::vector<std::uint32_t> TiledCpuRaycaster::trace(const RaycastParams& params) {
   return timedPass(params, [&](const glsl::RaycastPoolAccess& access) {
-    tbb::enumerable_thread_specific<std::unique_ptr<glsl::JitterCache>> caches;
+    tbb::enumerable_thread_specific<glsl::JitterCache> caches(params.image.z, params.sphere.y);
     const tbb::blocked_range2d<std::uint32_t> tiles(0, mHeight, kTileSize, 0, mWidth, kTileSize);
     tbb::parallel_for(tiles, [&](const tbb::blocked_range2d<std::uint32_t>& tile) {
-      auto& cache = caches.local();
-      if (!cache) cache = std::make_unique<glsl::JitterCache>(params.image.z, params.sphere.y);
-      glsl::TiledRaycastKernel kernel(access, *cache);
+      glsl::TiledRaycastKernel kernel(access, caches.local());
       for (std::uint32_t y = tile.rows().begin(); y != tile.rows().end(); ++y) {
         for (std::uint32_t x = tile.cols().begin(); x != tile.cols().end(); ++x) {
           RayHit& ray = mHits[std::size_t(y) * mWidth + x];

@@ -186,13 +186,59 @@ FS_FUNC float rcClearBlockExit(uint slot, ivec3 cell, vec3 o, vec3 invDir) {
   return max(rcBoxSpan(o, invDir, vec3(lo), vec3(lo + size)).y, 0.0f);
 }
 
+// The nearest sphere a brick march has met so far: its distance along the ray (3e38 while
+// none), the brick-local cell whose sphere it is, and the unnormalized normal at the hit.
+struct NearestSphere {
+  float t;
+  ivec3 cell;
+  vec3 normal;
+};
+
+FS_FUNC NearestSphere rcNoSphere() {
+  NearestSphere none;
+  none.t = 3.0e38f;
+  none.cell = ivec3(0);
+  none.normal = vec3(0.0f);
+  return none;
+}
+
+// §3.3.1: `nearest`, or the sphere of brick-local `cell`, centred at `centre`, where the ray
+// through brick-local point p = o + t dir meets it nearer (at t >= 0). Solved from p, not from
+// the ray's origin: p is within a few cells of the centre, so b * b - c does not cancel
+// catastrophically far from the camera.
+FS_FUNC NearestSphere rcNearerSphere(NearestSphere nearest, ivec3 cell, vec3 centre, vec3 p, float t, vec3 dir) {
+  float radius = P.sphere.x;
+  vec3 oc = p - centre;
+  float b = dot(oc, dir);
+  float c = dot(oc, oc) - radius * radius;
+  float disc = b * b - c;
+  if (disc < 0.0f) return nearest;
+  float local = -b - sqrt(disc);
+  float tHit = t + local;
+  if (tHit >= 0.0f && tHit < nearest.t) {
+    nearest.t = tHit;
+    nearest.cell = cell;
+    nearest.normal = (oc + local * dir) / radius;
+  }
+  return nearest;
+}
+
+// `result` as a hit on the sphere `nearest` of `slot`. A march ends on it once it lies no
+// farther than the exit of the cell just tested: a nearer one would have been found in an
+// earlier cell.
+FS_FUNC RayHit rcSphereHit(RayHit result, uint slot, NearestSphere nearest) {
+  result.normal = vec4(normalize(nearest.normal), rcCellAttribute(slot, nearest.cell));
+  result.t = nearest.t;
+  result.status = kRayHit;
+  return result;
+}
+
 // Traces the segment [t, tEnd] of the ray through resident brick `brick` (at `slot`). Returns a
 // hit in `result` (status kRayHit) or leaves result.status pending; with kFoamVolume it adds the
 // foam in front of the hit (or of tEnd) to result.foam and returns as soon as rcFoamOpaque.
 FS_FUNC RayHit rcTraceBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t, float tEnd) {
   int B = int(P.grid.w);
   int k = int(P.brick.y);
-  float radius = P.sphere.x;
   float jitter = P.sphere.y;
   vec3 brickOrigin = vec3(brick * uvec3(uint(B)));
   vec3 o = eye - brickOrigin;  // ray origin in brick-local cells
@@ -200,9 +246,7 @@ FS_FUNC RayHit rcTraceBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec
   // The nearest sphere hit found so far, from any cell tested in this brick. Spheres of cells
   // within k of the previously tested cell were tested already: a step tests only the cells
   // that enter the neighbourhood (9 of 27 for k = 1 on a face step).
-  float best = 3.0e38f;
-  ivec3 bestCell = ivec3(0);
-  vec3 bestNormal = vec3(0.0f);
+  NearestSphere nearest = rcNoSphere();
   ivec3 previous = ivec3(-1000000);
   for (uint step = 0u; step < kRaycastMaxSteps; step++) {
     if (t > tEnd) return result;
@@ -226,35 +270,17 @@ FS_FUNC RayHit rcTraceBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec
             uvec3 global = uvec3(ivec3(brick * uvec3(uint(B))) + q);
             centre += cellJitter(global, P.image.z, jitter);
           }
-          // Solved from the ray's current point p, not its origin: p is within a few cells of
-          // the centre, so b * b - c does not cancel catastrophically far from the camera.
-          vec3 oc = p - centre;
-          float b = dot(oc, dir);
-          float c = dot(oc, oc) - radius * radius;
-          float disc = b * b - c;
-          if (disc < 0.0f) continue;
-          float local = -b - sqrt(disc);
-          float tHit = t + local;
-          if (tHit >= 0.0f && tHit < best) {
-            best = tHit;
-            bestCell = q;
-            bestNormal = (oc + local * dir) / radius;
-          }
+          nearest = rcNearerSphere(nearest, q, centre, p, t, dir);
         }
       }
     }
     previous = cell;
     float cellExit = rcBoxSpan(o, invDir, vec3(cell), vec3(cell + ivec3(1))).y;
     if ((P.foam.x & kFoamVolume) != 0u) {
-      result.foam = rcAccumulateFoam(result.foam, slot, o, dir, t, min(cellExit, best));
+      result.foam = rcAccumulateFoam(result.foam, slot, o, dir, t, min(cellExit, nearest.t));
       if (rcFoamOpaque(result)) return result;
     }
-    if (best <= cellExit) {
-      result.normal = vec4(normalize(bestNormal), rcCellAttribute(slot, bestCell));
-      result.t = best;
-      result.status = kRayHit;
-      return result;
-    }
+    if (nearest.t <= cellExit) return rcSphereHit(result, slot, nearest);
     t = rcStepPast(cellExit);
   }
   return result;
