@@ -79,6 +79,8 @@ struct FramePipeline::Stages {
   std::unique_ptr<SurfaceFilter> filter;
   std::unique_ptr<SurfaceShading> shading;
   bool hitsOnDevice = false;      ///< the GPU's hit buffer is adopted, nothing is uploaded
+  bool thickness = false;         ///< the ray-caster traces the thickness (liquid shading)
+  bool litSpheres = false;        ///< spheres shading: the image's normals are the spheres'
 };
 
 FramePipeline::FramePipeline(BrickStore store, DeviceChoice device, const RenderSettings& settings,
@@ -109,7 +111,9 @@ void FramePipeline::init(std::shared_ptr<BrickSource> source,
                          const RenderSettings& requested) {
   const SurfaceSettings surface = mSurface;
   RenderSettings settings = requested;
-  settings.thicknessSaturationCells = thicknessSaturationCells(surface.shading);
+  // Only the liquid shading shows the thickness (§3.6); the other modes skip its trace.
+  settings.thicknessSaturationCells =
+      surface.shading.mode == ShadingMode::Liquid ? thicknessSaturationCells(surface.shading) : 0.0f;
   validate(settings);
   mSurface.smoothing = resolve(surface.smoothing);
   mSurface.shading.foam = settings.foam.mode == FoamMode::Volume;
@@ -132,6 +136,8 @@ void FramePipeline::init(std::shared_ptr<BrickSource> source,
   mScreen->setFrame(frame);
   mStages = std::make_unique<Stages>();
   Stages& s = *mStages;
+  s.thickness = settings.thicknessSaturationCells > 0.0f;
+  s.litSpheres = mSurface.shading.mode == ShadingMode::Spheres;
   if (auto* gpuScreen = dynamic_cast<GpuScreenDevice*>(mScreen.get())) {
     s.hits = gpuScreen->adoptFrameBuffer(&gpu->hitBuffer(), kVec4PerHit);
     s.hitsOnDevice = true;
@@ -234,12 +240,13 @@ void FramePipeline::shade(int frame, const Camera& camera, StageTimes& stages) {
       device.upload(s.hits, std::span<const glm::vec4>(reinterpret_cast<const glm::vec4*>(hits.data()),
                                                        hits.size() * kVec4PerHit));
     }
-    device.run(kSurface, nullptr, 0, {s.hits}, s.rawGbuffer);
-    device.run(kBlurThickness, nullptr, 0, {s.rawGbuffer}, s.gbuffer);
+    device.run(kSurface, nullptr, 0, {s.hits}, s.thickness ? s.rawGbuffer : s.gbuffer);
+    if (s.thickness) device.run(kBlurThickness, nullptr, 0, {s.rawGbuffer}, s.gbuffer);
     device.run(kSphereNormal, nullptr, 0, {s.hits}, s.sphereNormals);
   });
   timed(stages.smoothing, [&] { s.filter->apply(device, s.gbuffer, s.smoothed); });
-  timed(stages.normals, [&] { reconstructNormals(device, s.smoothed, s.normals); });
+  // The spheres shading lights the sphere normals; the surface's are not reconstructed.
+  if (!s.litSpheres) timed(stages.normals, [&] { reconstructNormals(device, s.smoothed, s.normals); });
   // The attribute values of the G-buffer's 0 and 1: the frame's quantization range.
   const StoreHeader& header = mRenderer->source().header();
   const FrameStats stats =
@@ -260,17 +267,25 @@ FrameOutput FramePipeline::readOutput() {
   image.width = device.width();
   image.height = device.height();
   image.rgba = device.download(s.shaded);
-  const auto gbuffer = device.download(s.gbuffer);
-  const auto smoothed = device.download(s.smoothed);
-  const auto normals = device.download(s.normals);
+  // The CPU device's images are read in place; the GPU's are downloaded.
+  auto* cpu = dynamic_cast<CpuScreenDevice*>(&device);
+  std::vector<glm::vec4> downloaded[4];
+  auto read = [&](ScreenImage handle, int slot) -> std::span<const glm::vec4> {
+    if (cpu) return cpu->pixels(handle);
+    downloaded[slot] = device.download(handle);
+    return downloaded[slot];
+  };
+  const auto gbuffer = read(s.gbuffer, 0);
+  const auto smoothed = read(s.smoothed, 1);
+  const auto normals = read(s.litSpheres ? s.sphereNormals : s.normals, 2);
   const std::size_t n = gbuffer.size();
   constexpr float kInf = std::numeric_limits<float>::infinity();
   image.depth.resize(n);
   image.unsmoothedDepth.resize(n);
-  image.thickness.resize(n);
+  if (s.thickness) image.thickness.resize(n);
   image.normal.resize(n);
   if (mSurface.shading.foam) {
-    const auto hitExtras = device.download(s.sphereNormals);
+    const auto hitExtras = s.litSpheres ? normals : read(s.sphereNormals, 3);
     image.foam.resize(n);
     for (std::size_t i = 0; i < n; ++i) image.foam[i] = glm::vec4(mSurface.shading.foamColour * hitExtras[i].w, hitExtras[i].w);
   }
@@ -283,7 +298,7 @@ FrameOutput FramePipeline::readOutput() {
     const bool hit = gbuffer[i].y > 0.5f;
     image.depth[i] = hit ? smoothed[i].x : kInf;
     image.unsmoothedDepth[i] = hit ? gbuffer[i].x : kInf;
-    image.thickness[i] = hit ? gbuffer[i].z : 0.0f;
+    if (s.thickness) image.thickness[i] = hit ? gbuffer[i].z : 0.0f;
     image.normal[i] = hit ? glm::vec3(normals[i]) : glm::vec3(0);
     if (attribute) image.attribute[i] = hit ? stats.attributeMin + gbuffer[i].w * span : 0.0f;
   }

@@ -85,6 +85,29 @@ TEST(FramePipeline, ShadingModesGiveDifferentLooks) {
   EXPECT_EQ(liquid.image.rgba[corner], spheres.image.rgba[corner]);
 }
 
+TEST(FramePipeline, OnlyTheLiquidShadingTracesTheThicknessAndSpheresKeepTheirNormals) {
+  const FrameOutput liquid = renderBall("none", ShadingMode::Liquid);
+  ASSERT_EQ(liquid.image.thickness.size(), liquid.image.depth.size());
+  for (ShadingMode mode : {ShadingMode::Spheres, ShadingMode::Normals})
+    EXPECT_TRUE(renderBall("none", mode).image.thickness.empty()) << int(mode);
+  // The spheres shading's normals are the spheres' (unit, facing the camera), not the
+  // reconstructed surface's: they differ from the liquid's at most pixels of the ball.
+  const FrameOutput spheres = renderBall("none", ShadingMode::Spheres);
+  const Camera camera = testing::BallScene().camera();
+  int hits = 0, differ = 0;
+  for (std::size_t i = 0; i < spheres.image.depth.size(); ++i) {
+    if (!std::isfinite(spheres.image.depth[i])) continue;
+    ++hits;
+    const glm::vec3 n = spheres.image.normal[i];
+    EXPECT_NEAR(glm::length(n), 1.0f, 1e-4f) << i;
+    const glm::dvec3 ray = camera.pixelRay(std::uint32_t(i % 128), std::uint32_t(i / 128), 128, 72);
+    EXPECT_LT(glm::dot(glm::dvec3(n), ray), 0.0) << i;
+    differ += glm::length(n - liquid.image.normal[i]) > 1e-3f;
+  }
+  EXPECT_GT(hits, 500);
+  EXPECT_GT(differ, hits / 2);
+}
+
 TEST(FramePipeline, EnvironmentMapErrorsNameTheFile) {
   testing::TempDir dir("pipeline");
   const testing::BallScene ball;
