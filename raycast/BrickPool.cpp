@@ -3,20 +3,23 @@
 #include <algorithm>
 
 #include "core/Error.h"
+#include "raycast/NearSphereMask.h"
 #include "streaming/BitBrickLayout.h"
 
 namespace flipscope {
 
 std::uint64_t PoolLayout::slotBytes() const {
-  return std::uint64_t(subBricksPerSlot) * (16 + (attributes ? 4 : 0) + (foam ? 16 : 0) + (halfCounts ? 4 : 0)) +
-         std::uint64_t(mipWordsPerSlot + (foam ? foamOccupancyWords() : 0)) * 4;
+  return std::uint64_t(subBricksPerSlot) * (16 + (attributes ? 4 : 0) + (foam ? 16 : 0) + (marchTables ? 4 : 0)) +
+         std::uint64_t(mipWordsPerSlot + (foam ? foamOccupancyWords() : 0)) * 4 +
+         (marchTables ? nearSphereMaskWords(brickSize) * 8 : 0);
 }
 
 PoolLayout PoolLayout::forBudget(std::uint32_t brickSize, std::uint32_t overlap, bool attributes,
-                                 std::uint64_t budgetBytes, bool foam, bool halfCounts) {
+                                 std::uint64_t budgetBytes, bool foam, bool marchTables, std::uint32_t reach) {
   PoolLayout layout;
   layout.foam = foam;
-  layout.halfCounts = halfCounts;
+  layout.marchTables = marchTables;
+  layout.reach = reach;
   layout.brickSize = brickSize;
   layout.overlap = overlap;
   const glm::uvec3 dims = bitBrickSubBrickDims(brickSize, overlap);

@@ -29,20 +29,24 @@ struct PoolLayout {
   bool foam = false;  ///< a foam bit-brick per slot (§3.5), the size of its bits, and its occupancy
   /// 32-bit words of a slot's foam occupancy (one bit per sub-brick; FoamClassify.glsl).
   std::uint32_t foamOccupancyWords() const { return (subBricksPerSlot + 31) / 32; }
-  /// Per sub-brick, 4 bytes: the sphere and the foam cells of each of its halves (the fast CPU
-  /// device's table, TiledCpuRaycaster; RaycastDevice::keepsHalfCounts).
-  bool halfCounts = false;
+  /// The fast CPU device's tables (TiledCpuRaycaster; RaycastDevice::keepsMarchTables): per
+  /// sub-brick, 4 bytes: the sphere and the foam cells of each of its halves; per brick cell, a
+  /// bit: whether a sphere cell lies within `reach` cells (NearSphereMask).
+  bool marchTables = false;
+  std::uint32_t reach = 0;  ///< of the spheres, in cells (sphereReach), with marchTables
   std::uint32_t slots = 0;
   std::uint64_t attributeCapacity = 0;  ///< 16-bit entries in the ring (even)
 
   /// Fixed bytes per slot: bits, mipmap, (with attributes) one 32-bit base per sub-brick, (with
-  /// foam) the foam bits and their occupancy, and (with halfCounts) the half counts.
+  /// foam) the foam bits and their occupancy, and (with marchTables) the fast CPU device's tables.
   std::uint64_t slotBytes() const;
   std::uint64_t bytes() const { return slotBytes() * slots + attributeCapacity * 2; }
   /// The largest pool within `budgetBytes`; with attributes, the ring gets room for about 35%
   /// filled bricks. Throws InputError when fewer than 3 slots fit (naming the minimum budget).
+  /// `reach` > 0 keeps the march tables for spheres of that reach.
   static PoolLayout forBudget(std::uint32_t brickSize, std::uint32_t overlap, bool attributes,
-                              std::uint64_t budgetBytes, bool foam = false, bool halfCounts = false);
+                              std::uint64_t budgetBytes, bool foam = false, bool marchTables = false,
+                              std::uint32_t reach = 0);
 };
 
 class BrickPool {

@@ -9,6 +9,7 @@
 
 #include "core/Error.h"
 #include "raycast/CpuRaycastKernel.h"
+#include "raycast/NearSphereMask.h"
 
 namespace flipscope {
 
@@ -42,7 +43,9 @@ void CpuRaycaster::allocatePool(const PoolLayout& layout) {
   mPool.foamOccupancy.clear();
   mPool.foamOccupancy.resize(layout.foam ? std::size_t(layout.slots) * layout.foamOccupancyWords() : 0);
   mPool.halfCounts.clear();
-  mPool.halfCounts.resize(layout.halfCounts ? std::size_t(layout.slots) * layout.subBricksPerSlot * 4 : 0);
+  mPool.halfCounts.resize(layout.marchTables ? std::size_t(layout.slots) * layout.subBricksPerSlot * 4 : 0);
+  mPool.nearSpheres.clear();
+  mPool.nearSpheres.resize(layout.marchTables ? std::size_t(layout.slots) * nearSphereMaskWords(layout.brickSize) : 0);
 }
 
 void CpuRaycaster::setOctree(std::span<const OctreeNode> nodes) {

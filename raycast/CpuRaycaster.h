@@ -45,9 +45,11 @@ class CpuRaycaster : public RaycastDevice {
     UninitializedVector<std::uint16_t> attributes;
     UninitializedVector<glm::uvec4> foamBits;  ///< with a foam pool: per slot, as subBricks
     UninitializedVector<std::uint32_t> foamOccupancy;  ///< per slot, PoolLayout::foamOccupancyWords
-    /// With PoolLayout::halfCounts: per slot and sub-brick, the sphere cells of its lower and
-    /// upper half (rcLiquidHalfCountOfBits), then its foam cells (rcFoamHalfCountOfBits).
+    /// With PoolLayout::marchTables: per slot and sub-brick, the sphere cells of its lower and
+    /// upper half (rcLiquidHalfCountOfBits), then its foam cells (rcFoamHalfCountOfBits);
     UninitializedVector<std::uint8_t> halfCounts;
+    /// and per slot, its NearSphereMask (nearSphereMaskWords) for spheres of PoolLayout::reach.
+    UninitializedVector<std::uint64_t> nearSpheres;
   };
   const Pool& pool() const { return mPool; }
 

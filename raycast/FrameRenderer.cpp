@@ -89,7 +89,7 @@ PoolLayout poolLayout(const StoreHeader& header, const RenderSettings& settings,
   std::uint64_t budget = settings.gpuBudgetBytes;
   for (;;) {
     PoolLayout layout = PoolLayout::forBudget(header.brickSize, storedOverlap(settings), attributes, budget, foam,
-                                              device.keepsHalfCounts());
+                                              device.keepsMarchTables(), sphereReach(settings.radius, settings.jitter));
     const std::uint64_t bits = std::uint64_t(layout.slots) * layout.subBricksPerSlot * 16;
     const std::uint64_t ring = layout.attributeCapacity * 2;
     if (bits <= maxBufferBytes && ring <= maxBufferBytes) return layout;

@@ -24,9 +24,9 @@ class RaycastDevice {
   virtual std::string name() const = 0;
   /// Largest single pool buffer the device takes (FrameRenderer shrinks the pool to fit).
   virtual std::uint64_t maxBufferBytes() const { return ~std::uint64_t(0); }
-  /// Whether the pool keeps a table of half block counts (PoolLayout::halfCounts), which the
+  /// Whether the pool keeps the fast CPU device's tables (PoolLayout::marchTables), which the
   /// budget then pays for.
-  virtual bool keepsHalfCounts() const { return false; }
+  virtual bool keepsMarchTables() const { return false; }
   /// Allocates the pool (every slot empty). Throws when the device cannot hold it.
   virtual void allocatePool(const PoolLayout& layout) = 0;
   /// The current frame's presence octree, and its page table: one slot (or kNotResident) per

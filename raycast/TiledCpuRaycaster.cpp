@@ -9,6 +9,7 @@
 
 #include "core/Error.h"
 #include "raycast/CpuRaycastKernel.h"
+#include "raycast/NearSphereMask.h"
 
 namespace flipscope {
 namespace {
@@ -99,7 +100,8 @@ struct TiledRaycastKernel : RaycastPoolAccess {
   /// rcTraceBrick's contract and result: the segment [t, tEnd] of the ray through the resident
   /// brick `brick` at `slot`, front to back, a 3D DDA from cell to cell. The first cell, and the
   /// first after a skipped clear mip block, tests its whole (2k+1)^3 neighbourhood; a step
-  /// along an axis tests the slab that enters it. The DDA's state is kept in scalar arrays (a
+  /// along an axis tests the slab that enters it; a cell without a sphere near (the slot's
+  /// NearSphereMask) tests none. The DDA's state is kept in scalar arrays (a
   /// vector indexed by a run-time axis goes through memory).
   RayHit rcMarchBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t, float tEnd) {
     const uvec3 brickCell = brick * uvec3(uint(B));
@@ -108,6 +110,12 @@ struct TiledRaycastKernel : RaycastPoolAccess {
     const std::size_t first = std::size_t(slot) * P.brick.w;
     const uvec4* bits = pool->subBricks.data() + first;
     const uvec4* foam = (P.foam.x & kFoamSkip) != 0u ? pool->foamBits.data() + first : nullptr;
+    // The slot's NearSphereMask, when it holds the spheres this march tests (without the foam
+    // cells exactly when they are skipped) for this reach.
+    const bool maskHolds = (!pool->layout.foam || foam) && uint(k) == pool->layout.reach;
+    const std::uint64_t* near =
+        maskHolds ? pool->nearSpheres.data() + std::size_t(slot) * nearSphereMaskWords(uint(B)) : nullptr;
+    const uint rowWords = uint(B + 63) / 64u;
     const float origin[3] = {o.x, o.y, o.z};
     const float inverse[3] = {invDir.x, invDir.y, invDir.z};
     const int step[3] = {dir.x < 0.0f ? -1 : 1, dir.y < 0.0f ? -1 : 1, dir.z < 0.0f ? -1 : 1};
@@ -139,14 +147,20 @@ struct TiledRaycastKernel : RaycastPoolAccess {
         continue;
       }
       const vec3 p = o + t * dir;
+      // With no sphere within k of this cell, its neighbourhood (and so the slab) holds none.
+      const bool test =
+          !near || ((near[uint(cell[2] * B + cell[1]) * rowWords + (uint(cell[0]) >> 6u)] >> (cell[0] & 63)) & 1u) != 0u;
       if (axis < 0) {
         for (int a = 0; a < 3; a++) exit[a] = planeExit(a);
-        for (int z = cell[2] - k; z <= cell[2] + k; z++)
-          for (int y = cell[1] - k; y <= cell[1] + k; y++)
-            for (int x = cell[0] - k; x <= cell[0] + k; x++) testCell(nearest, bits, foam, brickCell, x, y, z, p, t, dir);
         located = true;
       } else {
         exit[axis] = planeExit(axis);
+      }
+      if (test && axis < 0) {
+        for (int z = cell[2] - k; z <= cell[2] + k; z++)
+          for (int y = cell[1] - k; y <= cell[1] + k; y++)
+            for (int x = cell[0] - k; x <= cell[0] + k; x++) testCell(nearest, bits, foam, brickCell, x, y, z, p, t, dir);
+      } else if (test) {
         const int slab = cell[axis] + step[axis] * k;
         if (axis == 0) {
           for (int z = cell[2] - k; z <= cell[2] + k; z++)
@@ -177,10 +191,13 @@ std::string TiledCpuRaycaster::name() const {
   return "CPU (" + std::to_string(std::thread::hardware_concurrency()) + " threads)";
 }
 
-void TiledCpuRaycaster::countHalves(std::uint32_t slot) {
+void TiledCpuRaycaster::buildMarchTables(std::uint32_t slot) {
   const PoolLayout& layout = mPool.layout;
-  FLIPSCOPE_CHECK(layout.halfCounts && slot < layout.slots);
+  FLIPSCOPE_CHECK(layout.marchTables && slot < layout.slots);
   const std::size_t first = std::size_t(slot) * layout.subBricksPerSlot;
+  buildNearSphereMask(&mPool.subBricks[first], layout.foam ? &mPool.foamBits[first] : nullptr, layout.brickSize,
+                      layout.overlap, layout.reach,
+                      &mPool.nearSpheres[std::size_t(slot) * nearSphereMaskWords(layout.brickSize)]);
   for (std::size_t s = first; s < first + layout.subBricksPerSlot; ++s) {
     const glm::uvec4 foam = layout.foam ? mPool.foamBits[s] : glm::uvec4(0);
     const glm::uvec4 liquid = mPool.subBricks[s] & ~foam;
@@ -195,12 +212,12 @@ void TiledCpuRaycaster::countHalves(std::uint32_t slot) {
 void TiledCpuRaycaster::uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset, const ConvertedBrick& brick) {
   CpuRaycaster::uploadBrick(slot, attributeOffset, brick);
   // A foam pool's upload is classified (and counted there) before the next trace.
-  if (!mPool.layout.foam) countHalves(slot);
+  if (!mPool.layout.foam) buildMarchTables(slot);
 }
 
 void TiledCpuRaycaster::classifyFoam(std::span<const std::uint32_t> slots, const FoamClassifyParams& params) {
   CpuRaycaster::classifyFoam(slots, params);
-  tbb::parallel_for(std::size_t(0), slots.size(), [&](std::size_t i) { countHalves(slots[i]); });
+  tbb::parallel_for(std::size_t(0), slots.size(), [&](std::size_t i) { buildMarchTables(slots[i]); });
 }
 
 std::vector<std::uint32_t> TiledCpuRaycaster::trace(const RaycastParams& params) {

@@ -15,9 +15,12 @@
 //  - the march through a brick (§3.3.1) is a 3D DDA that keeps its state from cell to cell: a
 //    step tests only the slab of (2k+1)^2 cells entering the neighbourhood, read straight from
 //    the slot's sub-bricks, and the cell's exit comes from the DDA instead of a box test;
-//  - the pool keeps, per sub-brick, the sphere and foam cells of each half (PoolLayout::
-//    halfCounts, counted at upload and after foam classification), which the thickness trace
-//    (§3.6) and the foam volume (§3.5) read instead of counting bits at every sample.
+//  - the pool keeps march tables (PoolLayout::marchTables, built at upload and after foam
+//    classification): per brick cell, whether a sphere cell lies within the reach k
+//    (NearSphereMask), so that a step into a cell with none skips its slab tests (most steps
+//    near a surface); and per sub-brick, the sphere and foam cells of each half, which the
+//    thickness trace (§3.6) and the foam volume (§3.5) read instead of counting bits at every
+//    sample.
 // The rest of the pass (octree descent, requests, mip skipping, foam, attributes, thickness) is
 // Raycast.glsl itself, compiled once more around the new brick march (rcMarchBrick).
 #pragma once
@@ -29,14 +32,14 @@ namespace flipscope {
 class TiledCpuRaycaster : public CpuRaycaster {
  public:
   std::string name() const override;
-  bool keepsHalfCounts() const override { return true; }
+  bool keepsMarchTables() const override { return true; }
   void uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset, const ConvertedBrick& brick) override;
   void classifyFoam(std::span<const std::uint32_t> slots, const FoamClassifyParams& params) override;
   std::vector<std::uint32_t> trace(const RaycastParams& params) override;
 
  private:
-  /// Fills the pool's half counts of `slot` from its bits (and foam bits).
-  void countHalves(std::uint32_t slot);
+  /// Fills the pool's half counts and NearSphereMask of `slot` from its bits (and foam bits).
+  void buildMarchTables(std::uint32_t slot);
 };
 
 }  // namespace flipscope
