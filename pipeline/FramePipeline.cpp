@@ -178,7 +178,7 @@ ScreenFrame FramePipeline::screenFrame(const Camera& camera) const {
   return f;
 }
 
-FrameOutput FramePipeline::render(int frame, const Camera& camera, int direction) {
+const FrameOutput& FramePipeline::render(int frame, const Camera& camera, int direction) {
   const auto start = Clock::now();
   mFrame = frame;
   mCamera = camera;
@@ -187,7 +187,8 @@ FrameOutput FramePipeline::render(int frame, const Camera& camera, int direction
   stages.trace = msSince(start);
   shade(frame, camera, stages);
   const auto readStart = Clock::now();
-  FrameOutput out = readOutput();
+  FrameOutput& out = mOutput;
+  readOutput();
   stages.readback = msSince(readStart);
   out.stats = stats;
   out.stages = stages;
@@ -255,20 +256,27 @@ void FramePipeline::shade(int frame, const Camera& camera, StageTimes& stages) {
   timed(stages.shading, [&] { s.shading->shade(device, s.gbuffer, s.normals, s.sphereNormals, s.shaded); });
 }
 
-FrameOutput FramePipeline::readOutput() {
+const FrameOutput& FramePipeline::readOutput() {
   Stages& s = *mStages;
   ScreenDevice& device = *mScreen;
-  FrameOutput out;
+  FrameOutput& out = mOutput;
   out.frame = mFrame;
+  out.stats = {};
+  out.stages = {};
   const StoreHeader& header = mRenderer->source().header();
   const bool attribute = header.attribute != AttributeKind::None;
   const FrameStats stats = attribute ? mRenderer->source().frame(mFrame)->stats : FrameStats{};
   RenderImage& image = out.image;
   image.width = device.width();
   image.height = device.height();
-  image.rgba = device.download(s.shaded);
   // The CPU device's images are read in place; the GPU's are downloaded.
   auto* cpu = dynamic_cast<CpuScreenDevice*>(&device);
+  if (cpu) {
+    const auto shaded = cpu->pixels(s.shaded);
+    image.rgba.assign(shaded.begin(), shaded.end());
+  } else {
+    image.rgba = device.download(s.shaded);
+  }
   std::vector<glm::vec4> downloaded[4];
   auto read = [&](ScreenImage handle, int slot) -> std::span<const glm::vec4> {
     if (cpu) return cpu->pixels(handle);
@@ -282,8 +290,11 @@ FrameOutput FramePipeline::readOutput() {
   constexpr float kInf = std::numeric_limits<float>::infinity();
   image.depth.resize(n);
   image.unsmoothedDepth.resize(n);
-  if (s.thickness) image.thickness.resize(n);
+  image.thickness.resize(s.thickness ? n : 0);
   image.normal.resize(n);
+  image.foam.clear();
+  image.attribute.clear();
+  image.attributeName.clear();
   if (mSurface.shading.foam) {
     const auto hitExtras = s.litSpheres ? normals : read(s.sphereNormals, 3);
     image.foam.resize(n);

@@ -82,8 +82,9 @@ class FramePipeline {
   FramePipeline(const FramePipeline&) = delete;
   FramePipeline& operator=(const FramePipeline&) = delete;
 
-  /// The frame converged (or stopped at the pass limit), shaded and read back.
-  FrameOutput render(int frame, const Camera& camera, int direction = 0);
+  /// The frame converged (or stopped at the pass limit), shaded and read back. The output is
+  /// the pipeline's, valid until the next render() or readOutput(), which reuse its images.
+  const FrameOutput& render(int frame, const Camera& camera, int direction = 0);
 
   /// Progressive rendering for the viewer. begin() starts `frame` from `camera`; each advance()
   /// runs ray-caster passes for about `budgetMs` without waiting for brick conversion
@@ -99,8 +100,9 @@ class FramePipeline {
   void begin(int frame, const Camera& camera, int direction = 0);
   Progress advance(double budgetMs);
   bool finished() const { return mRenderer->finished(); }
-  /// The images of the last shaded frame (begin()'s frame), as render() returns them.
-  FrameOutput readOutput();
+  /// The images of the last shaded frame (begin()'s frame), as render() returns them (and as
+  /// long).
+  const FrameOutput& readOutput();
   /// The display image, rgba per pixel, row 0 at the top (zeros before the first advance()).
   std::vector<glm::vec4> downloadDisplay();
   /// The display image's shader storage buffer (vec4 per pixel) in the pipeline's OpenGL
@@ -123,6 +125,7 @@ class FramePipeline {
   std::unique_ptr<FrameRenderer> mRenderer;
   std::unique_ptr<ScreenDevice> mScreen;  // destroyed before the renderer's GL context
   std::unique_ptr<Stages> mStages;
+  FrameOutput mOutput;  ///< the last read back, its images reused frame to frame
   SurfaceSettings mSurface;
   int mFrame = 0;          ///< of the last begin() or render()
   Camera mCamera;

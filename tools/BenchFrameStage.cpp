@@ -50,26 +50,36 @@ void runStage(const FrameStageArgs& a) {
   const Camera camera = a.cameraFile.empty() ? defaultRenderCamera(pipeline.renderer().source(), frames.front(),
                                                                    frames.front(), width, height, look.surface.up)
                                              : loadCamera(a.cameraFile);
-  const FrameOutput first = pipeline.render(frames.front(), camera);
+  const FrameOutput& first = pipeline.render(frames.front(), camera);
   const double firstSeconds = secondsSince(start);
+  const RenderStats firstStats = first.stats;  // the warm frames reuse the output
   if (!a.image.empty()) {  // to look at, and with its depth (EXR) to compare
     writeImage(a.image, first.image);
     writeImage(fs::path(a.image).replace_extension(".exr"), first.image);
   }
   nlohmann::json warm = nlohmann::json::array(), warmTrace = nlohmann::json::array();
+  nlohmann::json warmStages = nlohmann::json::array();  // where a warm frame's time goes
   for (int i = 1; i <= a.request.orbitFrames; ++i) {
     const auto t = Clock::now();
-    const FrameOutput frame =
+    const FrameOutput& frame =
         pipeline.render(frames.front(), orbitAbout(camera, look.surface.up, kOrbitStepDegrees * i));
     warm.push_back(secondsSince(t) * 1e3);
     warmTrace.push_back(frame.stats.traceMs);
+    const StageTimes& st = frame.stages;
+    warmStages.push_back({{"trace", st.trace},
+                          {"gbuffer", st.gbuffer},
+                          {"smoothing", st.smoothing},
+                          {"normals", st.normals},
+                          {"shading", st.shading},
+                          {"readback", st.readback}});
   }
   const nlohmann::json j{{"device", pipeline.deviceName()},
                          {"first_image_s", firstSeconds},
-                         {"bricks_touched", first.stats.bricksUploaded},
-                         {"frame_bricks", first.stats.frameBricks},
+                         {"bricks_touched", firstStats.bricksUploaded},
+                         {"frame_bricks", firstStats.frameBricks},
                          {"warm_frame_ms", warm},
                          {"warm_trace_ms", warmTrace},
+                         {"warm_stages_ms", warmStages},
                          {"peak_rss_bytes", peakResidentBytes()}};
   writeTextAtomically(a.statsFile, j.dump(2) + "\n");
 }

@@ -404,7 +404,7 @@ void runBenchSurface(const BenchSurfaceArgs& a) {
     surface.smoothing.name = name;
     resolved[name] = resolve(surface.smoothing);
     FramePipeline pipeline(BrickStore::open(storeDir), qualityDevice, settings, surface);
-    const FrameOutput out = pipeline.render(0, camera);
+    const FrameOutput& out = pipeline.render(0, camera);
     quality[name] = measure(out.image, analytic, header.cellSize);
     writeImage(work / ("surface_" + name + ".png"), out.image);
     if (qualityName.empty()) {

@@ -85,10 +85,14 @@ std::uint64_t traceFrame(RTCScene scene, const Camera& camera, std::uint32_t wid
       rtcInitIntersectContext(&context);
       rtcIntersect16(valid, scene, &context, &rays);
       for (int i = 0; i < 16; ++i) {
-        if (!valid[i] || rays.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
+        if (!valid[i]) continue;
+        const std::uint32_t x = px * 4 + std::uint32_t(i % 4), y = py * 4 + std::uint32_t(i / 4);
+        if (rays.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) {
+          if (image) image->rgba[std::size_t(y) * width + x] = glm::vec4(0);
+          continue;
+        }
         ++rowHits;
         if (!image) continue;
-        const std::uint32_t x = px * 4 + std::uint32_t(i % 4), y = py * 4 + std::uint32_t(i / 4);
         const glm::vec3 n = glm::normalize(glm::vec3(rays.hit.Ng_x[i], rays.hit.Ng_y[i], rays.hit.Ng_z[i]));
         const glm::vec3 d(rays.ray.dir_x[i], rays.ray.dir_y[i], rays.ray.dir_z[i]);
         const float c = 0.15f + 0.85f * std::abs(glm::dot(n, d));
@@ -137,11 +141,12 @@ void runStage(const EmbreeStageArgs& a) {
   const std::uint64_t hits = traceFrame(scene, camera, width, height, &image);
   const double first = secondsSince(start);
   if (!a.image.empty()) writeImage(a.image, image);
-  // Warm frames, turned as the frame stage turns flipscope's.
+  // Warm frames, turned as the frame stage turns flipscope's; each shades its image, as
+  // flipscope's frames do.
   nlohmann::json warm = nlohmann::json::array();
   for (int i = 1; i <= a.request.orbitFrames; ++i) {
     const auto t = Clock::now();
-    traceFrame(scene, orbitAbout(camera, camera.up, kOrbitStepDegrees * i), width, height, nullptr);
+    traceFrame(scene, orbitAbout(camera, camera.up, kOrbitStepDegrees * i), width, height, &image);
     warm.push_back(secondsSince(t) * 1e3);
   }
   const std::int64_t embreePeak = memory.peak;

@@ -81,7 +81,7 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
 
   std::vector<RenderedFile> files;
   for (int f = first; f <= last; ++f) {
-    const FrameOutput result = pipeline.render(f, camera, last > first ? 1 : 0);
+    const FrameOutput& result = pipeline.render(f, camera, last > first ? 1 : 0);
     const std::string path = outputPathForFrame(job.output, f);
     writeImage(path, result.image);
     const RenderStats& s = result.stats;

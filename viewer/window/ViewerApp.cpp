@@ -359,7 +359,7 @@ void ViewerApp::runScript() {
 
 void ViewerApp::saveScreenshot(const std::filesystem::path& path) {
   if (!mPipeline) return;
-  FrameOutput out = mPipeline->readOutput();
+  const FrameOutput& out = mPipeline->readOutput();
   writeImage(path, out.image);
   mMessage = "saved " + path.string() + (mPipeline->finished() ? "" : " (not converged yet)");
   if (!mOptions.quiet) std::printf("view: %s\n", mMessage.c_str());
