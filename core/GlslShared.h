@@ -15,6 +15,8 @@
 
 #include <glm/glm.hpp>
 
+#include "core/FastFloor.h"
+
 #define FS_FUNC inline
 
 namespace flipscope::glsl {
@@ -47,14 +49,8 @@ using glm::atan;
 using std::exp;
 using std::pow;
 
-/// GLSL's floor. Without SSE4.1 (x86-64's baseline) std::floor is a call into libm, and the
-/// ray-casters floor every sample point; this is exact for every float (beyond 2^23 a float is
-/// an integer already; NaN and infinities come back as they are).
-inline float floor(float v) {
-  if (!(std::abs(v) < 8388608.0f)) return v;
-  const float truncated = float(int(v));
-  return truncated > v ? truncated - 1.0f : truncated;
-}
+/// GLSL's floor, exact and inline (core/FastFloor.h): the ray-casters floor every sample.
+inline float floor(float v) { return fastFloor(v); }
 inline vec2 floor(vec2 v) { return vec2(floor(v.x), floor(v.y)); }
 inline vec3 floor(vec3 v) { return vec3(floor(v.x), floor(v.y), floor(v.z)); }
 inline vec4 floor(vec4 v) { return vec4(floor(v.x), floor(v.y), floor(v.z), floor(v.w)); }

@@ -16,6 +16,7 @@
 #include <glm/geometric.hpp>
 
 #include "core/Error.h"
+#include "core/FastFloor.h"
 #include "core/Morton.h"
 
 namespace flipscope::detail {
@@ -91,7 +92,7 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, AttributeK
             continue;
           }
           const glm::dvec3 q(p);
-          const glm::dvec3 c = glm::floor((q - grid.header.origin) * grid.invCellSize);
+          const glm::dvec3 c = fastFloor((q - grid.header.origin) * grid.invCellSize);
           if ((grid.clip && !grid.clip->contains(q)) || c.x < 0 || c.y < 0 || c.z < 0 ||
               c.x >= double(grid.cells.x) || c.y >= double(grid.cells.y) || c.z >= double(grid.cells.z)) {
             keys[i] = kOutside;

@@ -21,6 +21,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/Error.h"
+#include "core/FastFloor.h"
 #include "preprocess/FiniteBounds.h"
 
 namespace flipscope {
@@ -120,6 +121,7 @@ class KthNeighbours {
       : mQueries(queries),
         mRadius(radius),
         mCell(2 * radius),
+        mInverseCell(1 / mCell),
         mHeaps(queries.positions.size() * kNeighbours, std::numeric_limits<float>::infinity()) {
     glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
     for (const glm::vec3& q : queries.positions) {
@@ -166,7 +168,9 @@ class KthNeighbours {
     std::uint32_t begin = 0, end = 0;  ///< queries mOrder[begin, end); empty slot when begin == end
   };
 
-  glm::ivec3 cellOf(const glm::dvec3& p) const { return glm::ivec3(glm::floor((p - mOrigin) / mCell)); }
+  /// In cells of the grid, from its origin; queries and candidates alike.
+  glm::dvec3 gridPoint(const glm::dvec3& p) const { return (p - mOrigin) * mInverseCell; }
+  glm::ivec3 cellOf(const glm::dvec3& p) const { return glm::ivec3(fastFloor(gridPoint(p))); }
 
   static std::uint64_t hash(const glm::ivec3& c) {
     std::uint64_t h = std::uint64_t(std::uint32_t(c.x)) | (std::uint64_t(std::uint32_t(c.y)) << 32);
@@ -300,8 +304,8 @@ class KthNeighbours {
     if (!isFinite(candidate)) return;
     const glm::dvec3 p(candidate);
     if (p.x < mLo.x || p.y < mLo.y || p.z < mLo.z || p.x > mHi.x || p.y > mHi.y || p.z > mHi.z) return;
-    const glm::dvec3 f = (p - mOrigin) / mCell;
-    const glm::dvec3 base = glm::floor(f);
+    const glm::dvec3 f = gridPoint(p);
+    const glm::dvec3 base = fastFloor(f);
     const glm::ivec3 cell(base);
     // A query within radius = half a cell lies in this cell or the neighbour on the side of
     // the half the candidate is in, on every axis.
@@ -327,7 +331,7 @@ class KthNeighbours {
   }
 
   const Sample& mQueries;
-  double mRadius, mCell;
+  double mRadius, mCell, mInverseCell;
   glm::dvec3 mOrigin{0}, mLo{0}, mHi{0};
   bool mUsable = false;
   std::vector<std::uint32_t> mOrder;

@@ -66,8 +66,9 @@ TEST(NearSphereMask, MatchesTheCellsWithASphereWithinReach) {
     EXPECT_GT(near, B * B * B / 100);  // the scene is neither empty
     EXPECT_LT(near, B * B * B * 9 / 10);  // nor full
     // A row's bits past the brick are clear.
-    if (c.brickSize % 64 != 0)
+    if (c.brickSize % 64 != 0) {
       for (std::size_t r = 0; r < std::size_t(B) * B; ++r) EXPECT_EQ(mask[r] >> c.brickSize, 0u) << r;
+    }
   }
 }
 
