@@ -67,7 +67,7 @@ EnvironmentMap loadEnvironmentMap(const std::filesystem::path& path) {
 
 /// The images and stage objects, created once the screen device exists.
 struct FramePipeline::Stages {
-  ScreenImage hits = 0;           ///< kVec4PerHit vec4 per pixel
+  ScreenImage hits = 0;           ///< kVec4PerHit vec4 per pixel: the ray-caster's, adopted
   ScreenImage rawGbuffer = 0;     ///< depth, mask, thickness, attribute
   ScreenImage gbuffer = 0;        ///< the same with the thickness blurred
   ScreenImage sphereNormals = 0;
@@ -78,7 +78,6 @@ struct FramePipeline::Stages {
   ScreenImage shown = 0;          ///< progressive: what it showed before
   std::unique_ptr<SurfaceFilter> filter;
   std::unique_ptr<SurfaceShading> shading;
-  bool hitsOnDevice = false;      ///< the GPU's hit buffer is adopted, nothing is uploaded
   bool thickness = false;         ///< the ray-caster traces the thickness (liquid shading)
   bool litSpheres = false;        ///< spheres shading: the image's normals are the spheres'
 };
@@ -140,9 +139,14 @@ void FramePipeline::init(std::shared_ptr<BrickSource> source,
   s.litSpheres = mSurface.shading.mode == ShadingMode::Spheres;
   if (auto* gpuScreen = dynamic_cast<GpuScreenDevice*>(mScreen.get())) {
     s.hits = gpuScreen->adoptFrameBuffer(&gpu->hitBuffer(), kVec4PerHit);
-    s.hitsOnDevice = true;
   } else {
-    s.hits = mScreen->createFrameImage(kVec4PerHit);
+    const auto& cpu = static_cast<const CpuRaycaster&>(mRenderer->device());
+    s.hits = static_cast<CpuScreenDevice&>(*mScreen).adoptFramePixels(
+        [&cpu] {
+          const std::vector<RayHit>& hits = cpu.hits();
+          return std::span<const glm::vec4>(reinterpret_cast<const glm::vec4*>(hits.data()), hits.size() * kVec4PerHit);
+        },
+        kVec4PerHit);
   }
   s.rawGbuffer = mScreen->createFrameImage();
   s.gbuffer = mScreen->createFrameImage();
@@ -236,11 +240,6 @@ void FramePipeline::shade(int frame, const Camera& camera, StageTimes& stages) {
   };
   device.setFrame(screenFrame(camera));
   timed(stages.gbuffer, [&] {
-    if (!s.hitsOnDevice) {
-      const auto& hits = static_cast<const CpuRaycaster&>(mRenderer->device()).hits();
-      device.upload(s.hits, std::span<const glm::vec4>(reinterpret_cast<const glm::vec4*>(hits.data()),
-                                                       hits.size() * kVec4PerHit));
-    }
     device.run(kSurface, nullptr, 0, {s.hits}, s.thickness ? s.rawGbuffer : s.gbuffer);
     if (s.thickness) device.run(kBlurThickness, nullptr, 0, {s.rawGbuffer}, s.gbuffer);
     device.run(kSphereNormal, nullptr, 0, {s.hits}, s.sphereNormals);

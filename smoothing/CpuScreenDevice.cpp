@@ -16,7 +16,7 @@ void CpuScreenDevice::setFrame(const ScreenFrame& frame) {
   mFrame = frame;
   if (!resized) return;
   for (Image& image : mImages)
-    if (image.perPixel) image.data.assign(std::size_t(frame.size.x) * frame.size.y * image.perPixel, glm::vec4(0));
+    if (image.perPixel && !image.adopted) image.data.assign(std::size_t(frame.size.x) * frame.size.y * image.perPixel, glm::vec4(0));
 }
 
 ScreenImage CpuScreenDevice::createFrameImage(std::uint32_t perPixel) {
@@ -35,15 +35,36 @@ CpuScreenDevice::Image& CpuScreenDevice::image(ScreenImage handle) {
   return mImages[handle];
 }
 
-std::span<glm::vec4> CpuScreenDevice::pixels(ScreenImage handle) { return image(handle).data; }
-
-void CpuScreenDevice::upload(ScreenImage handle, std::span<const glm::vec4> data) {
-  Image& target = image(handle);
-  FLIPSCOPE_CHECK(data.size() == target.data.size(), data.size() << " != " << target.data.size());
-  std::copy(data.begin(), data.end(), target.data.begin());
+ScreenImage CpuScreenDevice::adoptFramePixels(std::function<std::span<const glm::vec4>()> pixels,
+                                              std::uint32_t perPixel) {
+  FLIPSCOPE_CHECK(perPixel > 0 && pixels);
+  mImages.push_back({perPixel, {}, std::move(pixels)});
+  return ScreenImage(mImages.size() - 1);
 }
 
-std::vector<glm::vec4> CpuScreenDevice::download(ScreenImage handle) { return image(handle).data; }
+CpuScreenDevice::Image& CpuScreenDevice::target(ScreenImage handle) {
+  Image& target = image(handle);
+  FLIPSCOPE_CHECK(!target.adopted, "screen image " << handle << " is adopted: an input only");
+  return target;
+}
+
+std::span<const glm::vec4> CpuScreenDevice::read(ScreenImage handle) {
+  const Image& source = image(handle);
+  return source.adopted ? source.adopted() : std::span<const glm::vec4>(source.data);
+}
+
+std::span<glm::vec4> CpuScreenDevice::pixels(ScreenImage handle) { return target(handle).data; }
+
+void CpuScreenDevice::upload(ScreenImage handle, std::span<const glm::vec4> data) {
+  Image& image = target(handle);
+  FLIPSCOPE_CHECK(data.size() == image.data.size(), data.size() << " != " << image.data.size());
+  std::copy(data.begin(), data.end(), image.data.begin());
+}
+
+std::vector<glm::vec4> CpuScreenDevice::download(ScreenImage handle) {
+  const auto pixels = read(handle);
+  return {pixels.begin(), pixels.end()};
+}
 
 void CpuScreenDevice::run(const ScreenPass& pass, const void* params, std::size_t,
                           std::initializer_list<ScreenImage> inputs, ScreenImage output) {
@@ -53,26 +74,26 @@ void CpuScreenDevice::run(const ScreenPass& pass, const void* params, std::size_
   int slot = 0;
   for (ScreenImage handle : inputs) {
     FLIPSCOPE_CHECK(handle != output, pass.kernel << ": the output is also an input");
-    const Image& source = image(handle);
-    in.images[slot] = source.data.data();
-    in.sizes[slot] = source.data.size();
+    const auto pixels = read(handle);
+    in.images[slot] = pixels.data();
+    in.sizes[slot] = pixels.size();
     ++slot;
   }
-  Image& target = image(output);
-  FLIPSCOPE_CHECK(target.perPixel == 1, pass.kernel << ": the output must be a frame image");
-  pass.cpu(in, params, target.data.data());
+  Image& out = target(output);
+  FLIPSCOPE_CHECK(out.perPixel == 1, pass.kernel << ": the output must be a frame image");
+  pass.cpu(in, params, out.data.data());
 }
 
 void CpuScreenDevice::clear(ScreenImage handle) {
-  std::vector<glm::vec4>& data = image(handle).data;
+  std::vector<glm::vec4>& data = target(handle).data;
   std::fill(data.begin(), data.end(), glm::vec4(0));
 }
 
 void CpuScreenDevice::copy(ScreenImage from, ScreenImage to) {
-  const std::vector<glm::vec4>& source = image(from).data;
-  std::vector<glm::vec4>& target = image(to).data;
-  FLIPSCOPE_CHECK(source.size() == target.size(), source.size() << " != " << target.size());
-  std::copy(source.begin(), source.end(), target.begin());
+  const auto source = read(from);
+  std::vector<glm::vec4>& destination = target(to).data;
+  FLIPSCOPE_CHECK(source.size() == destination.size(), source.size() << " != " << destination.size());
+  std::copy(source.begin(), source.end(), destination.begin());
 }
 
 }  // namespace flipscope

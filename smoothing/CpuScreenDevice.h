@@ -3,6 +3,8 @@
 // task per band of rows.
 #pragma once
 
+#include <functional>
+#include <span>
 #include <vector>
 
 #include "smoothing/ScreenDevice.h"
@@ -22,15 +24,22 @@ class CpuScreenDevice : public ScreenDevice {
   void run(const ScreenPass& pass, const void* params, std::size_t paramBytes,
            std::initializer_list<ScreenImage> inputs, ScreenImage output) override;
 
-  /// The image's elements in place (no copy), for callers on the CPU.
+  /// The image's elements in place (no copy), for callers on the CPU; not of an adopted image.
   std::span<glm::vec4> pixels(ScreenImage image);
+  /// An image that passes read where `pixels` says it is, at each run (the CPU ray-caster's
+  /// hits, `perPixel` vec4 a pixel): nothing is copied. It is an input only.
+  ScreenImage adoptFramePixels(std::function<std::span<const glm::vec4>()> pixels, std::uint32_t perPixel);
 
  private:
   struct Image {
     std::uint32_t perPixel = 0;  ///< 0: fixed size
     std::vector<glm::vec4> data;
+    std::function<std::span<const glm::vec4>()> adopted;  ///< set: the pixels are elsewhere
   };
   Image& image(ScreenImage handle);
+  /// An image that is written to (not adopted).
+  Image& target(ScreenImage handle);
+  std::span<const glm::vec4> read(ScreenImage handle);
   std::vector<Image> mImages;
 };
 
