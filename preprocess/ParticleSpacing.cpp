@@ -308,14 +308,15 @@ class KthNeighbours {
     const glm::dvec3 base = fastFloor(f);
     const glm::ivec3 cell(base);
     // A query within radius = half a cell lies in this cell or the neighbour on the side of
-    // the half the candidate is in, on every axis.
-    const glm::ivec3 side(f.x - base.x < 0.5 ? -1 : 1, f.y - base.y < 0.5 ? -1 : 1, f.z - base.z < 0.5 ? -1 : 1);
+    // the half the candidate is in, on every axis: the octant's (no branches: the halves are
+    // a coin toss).
+    const int octant = int(f.x - base.x >= 0.5) | int(f.y - base.y >= 0.5) << 1 | int(f.z - base.z >= 0.5) << 2;
     if (!mBlockMask.empty() || !mNearBits.empty()) {  // most candidates have no query near
       if (glm::any(glm::lessThan(cell, glm::ivec3(-1))) || glm::any(glm::greaterThan(cell, mDims))) return;
       const std::size_t m = maskIndex(cell);
-      const int octant = (side.x > 0 ? 1 : 0) | (side.y > 0 ? 2 : 0) | (side.z > 0 ? 4 : 0);
       if (mNearBits.empty() ? !(mBlockMask[m] >> octant & 1) : !(mNearBits[m / 64] >> (m % 64) & 1)) return;
     }
+    const glm::ivec3 side(octantSide(octant, 0), octantSide(octant, 1), octantSide(octant, 2));
     const float radius2 = float(mRadius * mRadius);
     for (int corner = 0; corner < 8; ++corner) {
       const glm::ivec3 c = cell + glm::ivec3(corner & 1 ? side.x : 0, corner & 2 ? side.y : 0, corner & 4 ? side.z : 0);
