@@ -43,7 +43,7 @@ struct PoolLayout {
   std::uint64_t bytes() const { return slotBytes() * slots + attributeCapacity * 2; }
   /// The largest pool within `budgetBytes`; with attributes, the ring gets room for about 35%
   /// filled bricks. Throws InputError when fewer than 3 slots fit (naming the minimum budget).
-  /// `reach` > 0 keeps the march tables for spheres of that reach.
+  /// With `marchTables`, the tables are for spheres of `reach` (sphereReach) cells.
   static PoolLayout forBudget(std::uint32_t brickSize, std::uint32_t overlap, bool attributes,
                               std::uint64_t budgetBytes, bool foam = false, bool marchTables = false,
                               std::uint32_t reach = 0);

@@ -54,10 +54,10 @@ struct EmbreeMemory {
   }
 };
 
-/// One frame of primary rays in 4x4 packets, rows of packets over the cores; returns the hits
-/// and, with `image`, a head-lit grey picture of them.
+/// One frame of primary rays in 4x4 packets, rows of packets over the cores, shaded into
+/// `image` (a head-lit grey picture of the hits, 0 elsewhere); returns the hits.
 std::uint64_t traceFrame(RTCScene scene, const Camera& camera, std::uint32_t width, std::uint32_t height,
-                         RenderImage* image) {
+                         RenderImage& image) {
   const std::uint32_t packetsX = (width + 3) / 4, packetsY = (height + 3) / 4;
   std::atomic<std::uint64_t> hits{0};
   tbb::parallel_for(std::uint32_t(0), packetsY, [&](std::uint32_t py) {
@@ -88,15 +88,14 @@ std::uint64_t traceFrame(RTCScene scene, const Camera& camera, std::uint32_t wid
         if (!valid[i]) continue;
         const std::uint32_t x = px * 4 + std::uint32_t(i % 4), y = py * 4 + std::uint32_t(i / 4);
         if (rays.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) {
-          if (image) image->rgba[std::size_t(y) * width + x] = glm::vec4(0);
+          image.rgba[std::size_t(y) * width + x] = glm::vec4(0);
           continue;
         }
         ++rowHits;
-        if (!image) continue;
         const glm::vec3 n = glm::normalize(glm::vec3(rays.hit.Ng_x[i], rays.hit.Ng_y[i], rays.hit.Ng_z[i]));
         const glm::vec3 d(rays.ray.dir_x[i], rays.ray.dir_y[i], rays.ray.dir_z[i]);
         const float c = 0.15f + 0.85f * std::abs(glm::dot(n, d));
-        image->rgba[std::size_t(y) * width + x] = glm::vec4(c, c, c, 1);
+        image.rgba[std::size_t(y) * width + x] = glm::vec4(c, c, c, 1);
       }
     }
     hits += rowHits;
@@ -138,7 +137,7 @@ void runStage(const EmbreeStageArgs& a) {
   image.width = width;
   image.height = height;
   image.rgba.assign(std::size_t(width) * height, glm::vec4(0));
-  const std::uint64_t hits = traceFrame(scene, camera, width, height, &image);
+  const std::uint64_t hits = traceFrame(scene, camera, width, height, image);
   const double first = secondsSince(start);
   if (!a.image.empty()) writeImage(a.image, image);
   // Warm frames, turned as the frame stage turns flipscope's; each shades its image, as
@@ -146,7 +145,7 @@ void runStage(const EmbreeStageArgs& a) {
   nlohmann::json warm = nlohmann::json::array();
   for (int i = 1; i <= a.request.orbitFrames; ++i) {
     const auto t = Clock::now();
-    traceFrame(scene, orbitAbout(camera, camera.up, kOrbitStepDegrees * i), width, height, &image);
+    traceFrame(scene, orbitAbout(camera, camera.up, kOrbitStepDegrees * i), width, height, image);
     warm.push_back(secondsSince(t) * 1e3);
   }
   const std::int64_t embreePeak = memory.peak;
