@@ -30,8 +30,9 @@ struct PoolLayout {
   /// 32-bit words of a slot's foam occupancy (one bit per sub-brick; FoamClassify.glsl).
   std::uint32_t foamOccupancyWords() const { return (subBricksPerSlot + 31) / 32; }
   /// The fast CPU device's tables (TiledCpuRaycaster; RaycastDevice::keepsMarchTables): per
-  /// sub-brick, 4 bytes: the sphere and the foam cells of each of its halves; per brick cell, a
-  /// bit: whether a sphere cell lies within `reach` cells (NearSphereMask).
+  /// sub-brick, 4 bytes: the sphere and the foam cells of each of its halves, and a byte: its
+  /// ClearDistance; per brick cell, a bit: whether a sphere cell lies within `reach` cells
+  /// (NearSphereMask).
   bool marchTables = false;
   std::uint32_t reach = 0;  ///< of the spheres, in cells (sphereReach), with marchTables
   std::uint32_t slots = 0;

@@ -46,6 +46,8 @@ void CpuRaycaster::allocatePool(const PoolLayout& layout) {
   mPool.halfCounts.resize(layout.marchTables ? std::size_t(layout.slots) * layout.subBricksPerSlot * 4 : 0);
   mPool.nearSpheres.clear();
   mPool.nearSpheres.resize(layout.marchTables ? std::size_t(layout.slots) * nearSphereMaskWords(layout.brickSize) : 0);
+  mPool.clearDistances.clear();
+  mPool.clearDistances.resize(layout.marchTables ? std::size_t(layout.slots) * layout.subBricksPerSlot : 0);
 }
 
 void CpuRaycaster::setOctree(std::span<const OctreeNode> nodes) {

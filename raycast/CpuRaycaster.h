@@ -48,8 +48,10 @@ class CpuRaycaster : public RaycastDevice {
     /// With PoolLayout::marchTables: per slot and sub-brick, the sphere cells of its lower and
     /// upper half (rcLiquidHalfCountOfBits), then its foam cells (rcFoamHalfCountOfBits);
     UninitializedVector<std::uint8_t> halfCounts;
-    /// and per slot, its NearSphereMask (nearSphereMaskWords) for spheres of PoolLayout::reach.
+    /// per slot, its NearSphereMask (nearSphereMaskWords) for spheres of PoolLayout::reach;
     UninitializedVector<std::uint64_t> nearSpheres;
+    /// and per slot and sub-brick (a level-1 mip block), its ClearDistance.
+    UninitializedVector<std::uint8_t> clearDistances;
   };
   const Pool& pool() const { return mPool; }
 

@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/Error.h"
+#include "raycast/ClearDistance.h"
 #include "raycast/CpuRaycastKernel.h"
 #include "raycast/NearSphereMask.h"
 
@@ -98,11 +99,13 @@ struct TiledRaycastKernel : RaycastPoolAccess {
   }
 
   /// rcTraceBrick's contract and result: the segment [t, tEnd] of the ray through the resident
-  /// brick `brick` at `slot`, front to back, a 3D DDA from cell to cell. The first cell, and the
-  /// first after a skipped clear mip block, tests its whole (2k+1)^3 neighbourhood; a step
-  /// along an axis tests the slab that enters it; a cell without a sphere near (the slot's
-  /// NearSphereMask) tests none. The DDA's state is kept in scalar arrays (a
-  /// vector indexed by a run-time axis goes through memory).
+  /// brick `brick` at `slot`, front to back, a 3D DDA from cell to cell. The first cell tests its
+  /// whole (2k+1)^3 neighbourhood; a step along an axis tests the slab that enters it; a cell
+  /// without a sphere near (the slot's NearSphereMask) tests none. A clear mip block has no
+  /// stored cell within k of it (the mipmap's dilation is the reach, buildBrickMipmap), so the
+  /// cell a ray meets on leaving one through a face tests only its far slab, as after a step;
+  /// through an edge or a corner, its whole neighbourhood. The DDA's state is kept in scalar
+  /// arrays (a vector indexed by a run-time axis goes through memory).
   RayHit rcMarchBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t, float tEnd) {
     const uvec3 brickCell = brick * uvec3(uint(B));
     const vec3 o = eye - vec3(brickCell);
@@ -116,6 +119,7 @@ struct TiledRaycastKernel : RaycastPoolAccess {
     const std::uint64_t* near =
         maskHolds ? pool->nearSpheres.data() + std::size_t(slot) * nearSphereMaskWords(uint(B)) : nullptr;
     const uint rowWords = uint(B + 63) / 64u;
+    const std::uint8_t* clearDistances = pool->clearDistances.data() + first;
     const float origin[3] = {o.x, o.y, o.z};
     const float inverse[3] = {invDir.x, invDir.y, invDir.z};
     const int step[3] = {dir.x < 0.0f ? -1 : 1, dir.y < 0.0f ? -1 : 1, dir.z < 0.0f ? -1 : 1};
@@ -123,16 +127,25 @@ struct TiledRaycastKernel : RaycastPoolAccess {
     int cell[3] = {0, 0, 0};
     float exit[3] = {0.0f, 0.0f, 0.0f};  // where the ray leaves the cell across each axis's far plane
     bool located = false;
+    // The last clear mip block skipped, [clearLo, clearHi) in brick-local cells, while the ray
+    // has met no other cell since.
+    bool leftClearBlock = false;
+    int clearLo[3] = {0, 0, 0}, clearHi[3] = {0, 0, 0};
     auto planeExit = [&](int axis) {
       return (float(cell[axis] + (step[axis] > 0 ? 1 : 0)) - origin[axis]) * inverse[axis];
     };
     for (uint n = 0u; n < kRaycastMaxSteps; n++) {
       int axis = -1;  // the axis of the DDA step into this cell; -1 when located afresh
+      // The one slab of the neighbourhood to test, at cell[slabAxis] + slabSide * k; slabAxis -1
+      // tests the whole neighbourhood.
+      int slabAxis = -1, slabSide = 0;
       if (located) {
         axis = exit[0] <= exit[1] ? (exit[0] <= exit[2] ? 0 : 2) : (exit[1] <= exit[2] ? 1 : 2);
         t = rcStepPast(exit[axis]);
         cell[axis] += step[axis];
         if (t > tEnd || cell[axis] < 0 || cell[axis] >= B) return result;
+        slabAxis = axis;
+        slabSide = step[axis];
       } else {
         if (t > tEnd) return result;
         const ivec3 c = clamp(ivec3(floor(o + t * dir)), ivec3(0), ivec3(B - 1));
@@ -140,11 +153,33 @@ struct TiledRaycastKernel : RaycastPoolAccess {
         cell[1] = c.y;
         cell[2] = c.z;
       }
-      const float clearExit = rcClearBlockExit(slot, ivec3(cell[0], cell[1], cell[2]), o, invDir);
-      if (clearExit >= 0.0f) {
-        t = rcStepPast(clearExit);
+      const ivec3 block((cell[0] + overlap) >> 2, (cell[1] + overlap) >> 2, (cell[2] + overlap) >> 3);
+      const int distance = clearDistances[uint(block.x) + subBrickDims.x * (uint(block.y) + subBrickDims.y * uint(block.z))];
+      if (distance > 0) {
+        // The cube of clear blocks within distance - 1 of this one (ClearDistance).
+        const ivec3 lo = (block - ivec3(distance - 1)) * ivec3(4, 4, 8) - ivec3(overlap);
+        const ivec3 hi = (block + ivec3(distance)) * ivec3(4, 4, 8) - ivec3(overlap);
+        t = rcStepPast(max(rcBoxSpan(o, invDir, vec3(lo), vec3(hi)).y, 0.0f));
         located = false;
+        leftClearBlock = true;
+        clearLo[0] = lo.x, clearLo[1] = lo.y, clearLo[2] = lo.z;
+        clearHi[0] = hi.x, clearHi[1] = hi.y, clearHi[2] = hi.z;
         continue;
+      }
+      if (leftClearBlock) {
+        // Beside the block across one face: the cells within k of its neighbour inside the
+        // block hold no sphere, so only the far slab remains.
+        int outside = 0;
+        for (int a = 0; a < 3; a++) {
+          const int side = cell[a] < clearLo[a] ? -1 : cell[a] >= clearHi[a] ? 1 : 0;
+          const int gap = side < 0 ? clearLo[a] - cell[a] : side > 0 ? cell[a] - clearHi[a] + 1 : 0;
+          if (side == 0) continue;
+          outside += gap == 1 ? 1 : 2;
+          slabAxis = a;
+          slabSide = side;
+        }
+        if (outside != 1) slabAxis = -1;
+        leftClearBlock = false;
       }
       const vec3 p = o + t * dir;
       // With no sphere within k of this cell, its neighbourhood (and so the slab) holds none.
@@ -156,16 +191,16 @@ struct TiledRaycastKernel : RaycastPoolAccess {
       } else {
         exit[axis] = planeExit(axis);
       }
-      if (test && axis < 0) {
+      if (test && slabAxis < 0) {
         for (int z = cell[2] - k; z <= cell[2] + k; z++)
           for (int y = cell[1] - k; y <= cell[1] + k; y++)
             for (int x = cell[0] - k; x <= cell[0] + k; x++) testCell(nearest, bits, foam, brickCell, x, y, z, p, t, dir);
       } else if (test) {
-        const int slab = cell[axis] + step[axis] * k;
-        if (axis == 0) {
+        const int slab = cell[slabAxis] + slabSide * k;
+        if (slabAxis == 0) {
           for (int z = cell[2] - k; z <= cell[2] + k; z++)
             for (int y = cell[1] - k; y <= cell[1] + k; y++) testCell(nearest, bits, foam, brickCell, slab, y, z, p, t, dir);
-        } else if (axis == 1) {
+        } else if (slabAxis == 1) {
           for (int z = cell[2] - k; z <= cell[2] + k; z++)
             for (int x = cell[0] - k; x <= cell[0] + k; x++) testCell(nearest, bits, foam, brickCell, x, slab, z, p, t, dir);
         } else {
@@ -198,6 +233,9 @@ void TiledCpuRaycaster::buildMarchTables(std::uint32_t slot) {
   buildNearSphereMask(&mPool.subBricks[first], layout.foam ? &mPool.foamBits[first] : nullptr, layout.brickSize,
                       layout.overlap, layout.reach,
                       &mPool.nearSpheres[std::size_t(slot) * nearSphereMaskWords(layout.brickSize)]);
+  // Level-1 mip bits lead the slot's mip words (bitBrickMipWordOffset(1) = 0).
+  buildClearDistances(&mPool.mipWords[std::size_t(slot) * layout.mipWordsPerSlot],
+                      bitBrickMipDims(1u, layout.brickSize, layout.overlap), &mPool.clearDistances[first]);
   for (std::size_t s = first; s < first + layout.subBricksPerSlot; ++s) {
     const glm::uvec4 foam = layout.foam ? mPool.foamBits[s] : glm::uvec4(0);
     const glm::uvec4 liquid = mPool.subBricks[s] & ~foam;

@@ -18,10 +18,14 @@
 //  - the pool keeps march tables (PoolLayout::marchTables, built at upload and after foam
 //    classification): per brick cell, whether a sphere cell lies within the reach k
 //    (NearSphereMask), so that a step into a cell with none skips its slab tests (most steps
-//    near a surface); and per sub-brick, the sphere and foam cells of each half, which the
+//    near a surface); per sub-brick, the sphere and foam cells of each half, which the
 //    thickness trace (§3.6) and the foam volume (§3.5) read instead of counting bits at every
-//    sample.
-// The rest of the pass (octree descent, requests, mip skipping, foam, attributes, thickness) is
+//    sample; and per level-1 mip block, the distance to the nearest set one (ClearDistance);
+//  - empty space (§4.2) is skipped by the cube of clear mip blocks centred on the ray's block
+//    (ClearDistance), one table read, instead of the reference's walk up the mip levels to an
+//    aligned block: half as many skips. The cell met on leaving the cube through a face tests
+//    only its far slab, since no stored cell lies within the reach of the cube.
+// The rest of the pass (octree descent, requests, foam, attributes, thickness) is
 // Raycast.glsl itself, compiled once more around the new brick march (rcMarchBrick).
 #pragma once
 
