@@ -7,6 +7,8 @@
 #include <limits>
 
 #include <glm/trigonometric.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "core/Error.h"
 #include "raycast/CpuRaycaster.h"
@@ -304,14 +306,16 @@ const FrameOutput& FramePipeline::readOutput() {
     image.attributeName = header.attributeName;
   }
   const float span = stats.attributeMax - stats.attributeMin;
-  for (std::size_t i = 0; i < n; ++i) {
-    const bool hit = gbuffer[i].y > 0.5f;
-    image.depth[i] = hit ? smoothed[i].x : kInf;
-    image.unsmoothedDepth[i] = hit ? gbuffer[i].x : kInf;
-    if (s.thickness) image.thickness[i] = hit ? gbuffer[i].z : 0.0f;
-    image.normal[i] = hit ? glm::vec3(normals[i]) : glm::vec3(0);
-    if (attribute) image.attribute[i] = hit ? stats.attributeMin + gbuffer[i].w * span : 0.0f;
-  }
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1 << 14), [&](const tbb::blocked_range<std::size_t>& rows) {
+    for (std::size_t i = rows.begin(); i != rows.end(); ++i) {
+      const bool hit = gbuffer[i].y > 0.5f;
+      image.depth[i] = hit ? smoothed[i].x : kInf;
+      image.unsmoothedDepth[i] = hit ? gbuffer[i].x : kInf;
+      if (s.thickness) image.thickness[i] = hit ? gbuffer[i].z : 0.0f;
+      image.normal[i] = hit ? glm::vec3(normals[i]) : glm::vec3(0);
+      if (attribute) image.attribute[i] = hit ? stats.attributeMin + gbuffer[i].w * span : 0.0f;
+    }
+  });
   return out;
 }
 
