@@ -1,4 +1,4 @@
-// ClearDistance: the Chebyshev distance transform of a brick's level-1 mip blocks (see the header).
+// ClearDistance: the Chebyshev distance transform of a grid of blocks (see the header).
 #include "raycast/ClearDistance.h"
 
 #include <algorithm>
@@ -6,7 +6,7 @@
 
 namespace flipscope {
 
-void buildClearDistances(const std::uint32_t* level1, glm::uvec3 dims, std::uint8_t* distances) {
+void buildClearDistances(const std::uint32_t* setBlocks, glm::uvec3 dims, std::uint8_t* distances) {
   const int nx = int(dims.x), ny = int(dims.y), nz = int(dims.z);
   const int cap = kMaxClearDistance;
   auto at = [&](int x, int y, int z) { return std::size_t(x) + std::size_t(nx) * (std::size_t(y) + std::size_t(ny) * z); };
@@ -18,7 +18,7 @@ void buildClearDistances(const std::uint32_t* level1, glm::uvec3 dims, std::uint
       int d = cap;
       for (int x = 0; x < nx; x++) {
         const std::size_t i = at(x, y, z);
-        d = ((level1[i >> 5] >> (i & 31)) & 1u) != 0u ? 0 : std::min(d + 1, cap);
+        d = ((setBlocks[i >> 5] >> (i & 31)) & 1u) != 0u ? 0 : std::min(d + 1, cap);
         alongX[i] = std::uint8_t(d);
       }
       d = cap;

@@ -48,6 +48,8 @@ void CpuRaycaster::allocatePool(const PoolLayout& layout) {
   mPool.nearSpheres.resize(layout.marchTables ? std::size_t(layout.slots) * nearSphereMaskWords(layout.brickSize) : 0);
   mPool.clearDistances.clear();
   mPool.clearDistances.resize(layout.marchTables ? std::size_t(layout.slots) * layout.subBricksPerSlot : 0);
+  mPool.nearDistances.clear();
+  mPool.nearDistances.resize(layout.marchTables ? std::size_t(layout.slots) * nearSphereGroupCount(layout.brickSize) : 0);
 }
 
 void CpuRaycaster::setOctree(std::span<const OctreeNode> nodes) {

@@ -50,8 +50,11 @@ class CpuRaycaster : public RaycastDevice {
     UninitializedVector<std::uint8_t> halfCounts;
     /// per slot, its NearSphereMask (nearSphereMaskWords) for spheres of PoolLayout::reach;
     UninitializedVector<std::uint64_t> nearSpheres;
-    /// and per slot and sub-brick (a level-1 mip block), its ClearDistance.
+    /// per slot and sub-brick (a level-1 mip block), its ClearDistance;
     UninitializedVector<std::uint8_t> clearDistances;
+    /// and per slot and group of 4^3 brick cells (nearSphereGroups), the ClearDistance of the
+    /// groups with a cell set in the NearSphereMask.
+    UninitializedVector<std::uint8_t> nearDistances;
   };
   const Pool& pool() const { return mPool; }
 

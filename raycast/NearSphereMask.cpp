@@ -1,5 +1,6 @@
 #include "raycast/NearSphereMask.h"
 
+#include <algorithm>
 #include <array>
 #include <vector>
 
@@ -96,6 +97,29 @@ void buildNearSphereMask(const glm::uvec4* bits, const glm::uvec4* foam, std::ui
         for (std::uint32_t dz = 0; dz <= 2 * k; ++dz) v |= alongY[(std::size_t(z + dz) * B + y) * W + w];
         mask[(std::size_t(z) * B + y) * W + w] = v;
       }
+}
+
+std::size_t nearSphereGroupCount(std::uint32_t brickSize) {
+  const std::size_t g = brickSize / kNearGroupCells;
+  return g * g * g;
+}
+
+void nearSphereGroups(const std::uint64_t* mask, std::uint32_t brickSize, std::uint32_t* groups) {
+  FLIPSCOPE_CHECK(brickSize % kNearGroupCells == 0 && brickSize <= 128, "brick " << brickSize);
+  const std::uint32_t B = brickSize, W = (B + 63) / 64, G = B / kNearGroupCells;
+  std::fill(groups, groups + (nearSphereGroupCount(B) + 31) / 32, 0u);
+  for (std::uint32_t gz = 0; gz < G; ++gz)
+    for (std::uint32_t gy = 0; gy < G; ++gy) {
+      std::array<std::uint64_t, 2> rows{};  // the group row's 4 x 4 mask rows, or-ed
+      for (std::uint32_t z = gz * 4; z < gz * 4 + 4; ++z)
+        for (std::uint32_t y = gy * 4; y < gy * 4 + 4; ++y)
+          for (std::uint32_t w = 0; w < W; ++w) rows[w] |= mask[(std::size_t(z) * B + y) * W + w];
+      for (std::uint32_t gx = 0; gx < G; ++gx) {
+        if (((rows[gx / 16] >> ((gx % 16) * 4)) & 0xfu) == 0u) continue;
+        const std::size_t i = gx + std::size_t(G) * (gy + std::size_t(G) * gz);
+        groups[i / 32] |= 1u << (i % 32);
+      }
+    }
 }
 
 }  // namespace flipscope

@@ -22,4 +22,15 @@ std::size_t nearSphereMaskWords(std::uint32_t brickSize);
 void buildNearSphereMask(const glm::uvec4* bits, const glm::uvec4* foam, std::uint32_t brickSize,
                          std::uint32_t overlap, std::uint32_t reach, std::uint64_t* mask);
 
+/// Cells per edge of a near-sphere group: the mask's cells in cubes of 4^3.
+inline constexpr std::uint32_t kNearGroupCells = 4;
+
+/// Groups of one brick, (brickSize / 4)^3.
+std::size_t nearSphereGroupCount(std::uint32_t brickSize);
+
+/// Per group of 4^3 cells of a brick's `mask`, whether any of its cells is set: bit i of
+/// `groups` (nearSphereGroupCount / 32 words, rounded up), i = gx + G * (gy + G * gz) for
+/// G = brickSize / 4. Needs brickSize a multiple of 4.
+void nearSphereGroups(const std::uint64_t* mask, std::uint32_t brickSize, std::uint32_t* groups);
+
 }  // namespace flipscope

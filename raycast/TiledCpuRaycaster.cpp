@@ -101,10 +101,10 @@ struct TiledRaycastKernel : RaycastPoolAccess {
   /// rcTraceBrick's contract and result: the segment [t, tEnd] of the ray through the resident
   /// brick `brick` at `slot`, front to back, a 3D DDA from cell to cell. The first cell tests its
   /// whole (2k+1)^3 neighbourhood; a step along an axis tests the slab that enters it; a cell
-  /// without a sphere near (the slot's NearSphereMask) tests none. A clear mip block has no
-  /// stored cell within k of it (the mipmap's dilation is the reach, buildBrickMipmap), so the
-  /// cell a ray meets on leaving one through a face tests only its far slab, as after a step;
-  /// through an edge or a corner, its whole neighbourhood. The DDA's state is kept in scalar
+  /// without a sphere near (the slot's NearSphereMask) tests none. A cube of clear blocks
+  /// (ClearDistance) is crossed at once; no sphere lies within k of it (the mipmap's dilation is
+  /// the reach, buildBrickMipmap), so the cell a ray meets on leaving one through a face tests
+  /// only its far slab, as after a step; through an edge or a corner, its whole neighbourhood. The DDA's state is kept in scalar
   /// arrays (a vector indexed by a run-time axis goes through memory). The vectors come by
   /// reference: by value, rcTrace stored them in halves and the call read them whole, a stalled
   /// store per brick (2% of the trace).
@@ -122,7 +122,18 @@ struct TiledRaycastKernel : RaycastPoolAccess {
     const std::uint64_t* near =
         maskHolds ? pool->nearSpheres.data() + std::size_t(slot) * nearSphereMaskWords(uint(B)) : nullptr;
     const uint rowWords = uint(B + 63) / 64u;
-    const std::uint8_t* clearDistances = pool->clearDistances.data() + first;
+    // Empty space to skip (ClearDistance): with the mask, cubes of 4^3-cell groups with no sphere
+    // near; else, and with the foam volume (whose cells the mask leaves out but the ray
+    // gathers), cubes of clear level-1 mip blocks (4x4x8 stored cells, foam cells included).
+    const bool groups = near && (P.foam.x & kFoamVolume) == 0u;
+    const int groupsPerEdge = B / int(kNearGroupCells);
+    const std::uint8_t* distances =
+        groups ? pool->nearDistances.data() + std::size_t(slot) * nearSphereGroupCount(uint(B))
+               : pool->clearDistances.data() + first;
+    const ivec3 blockCells = groups ? ivec3(int(kNearGroupCells)) : ivec3(kSubBrickCells);
+    const ivec3 blockShift = groups ? ivec3(2) : ivec3(2, 2, 3);
+    const ivec3 blockDims = groups ? ivec3(groupsPerEdge) : ivec3(subBrickDims);
+    const int blockOrigin = groups ? 0 : overlap;  // the first block's corner is at brick-local -blockOrigin
     const float origin[3] = {o.x, o.y, o.z};
     const float inverse[3] = {invDir.x, invDir.y, invDir.z};
     const int step[3] = {dir.x < 0.0f ? -1 : 1, dir.y < 0.0f ? -1 : 1, dir.z < 0.0f ? -1 : 1};
@@ -130,8 +141,8 @@ struct TiledRaycastKernel : RaycastPoolAccess {
     int cell[3] = {0, 0, 0};
     float exit[3] = {0.0f, 0.0f, 0.0f};  // where the ray leaves the cell across each axis's far plane
     bool located = false;
-    // The last clear mip block skipped, [clearLo, clearHi) in brick-local cells, while the ray
-    // has met no other cell since.
+    // The last cube of clear blocks skipped, [clearLo, clearHi) in brick-local cells, while the
+    // ray has met no other cell since.
     bool leftClearBlock = false;
     int clearLo[3] = {0, 0, 0}, clearHi[3] = {0, 0, 0};
     auto planeExit = [&](int axis) {
@@ -156,12 +167,12 @@ struct TiledRaycastKernel : RaycastPoolAccess {
         cell[1] = c.y;
         cell[2] = c.z;
       }
-      const ivec3 block((cell[0] + overlap) >> 2, (cell[1] + overlap) >> 2, (cell[2] + overlap) >> 3);
-      const int distance = clearDistances[uint(block.x) + subBrickDims.x * (uint(block.y) + subBrickDims.y * uint(block.z))];
+      const ivec3 block = (ivec3(cell[0], cell[1], cell[2]) + ivec3(blockOrigin)) >> blockShift;
+      const int distance = distances[block.x + blockDims.x * (block.y + blockDims.y * block.z)];
       if (distance > 0) {
         // The cube of clear blocks within distance - 1 of this one (ClearDistance).
-        const ivec3 lo = (block - ivec3(distance - 1)) * ivec3(4, 4, 8) - ivec3(overlap);
-        const ivec3 hi = (block + ivec3(distance)) * ivec3(4, 4, 8) - ivec3(overlap);
+        const ivec3 lo = (block - ivec3(distance - 1)) * blockCells - ivec3(blockOrigin);
+        const ivec3 hi = (block + ivec3(distance)) * blockCells - ivec3(blockOrigin);
         t = rcStepPast(max(rcBoxSpan(o, invDir, vec3(lo), vec3(hi)).y, 0.0f));
         located = false;
         leftClearBlock = true;
@@ -233,9 +244,14 @@ void TiledCpuRaycaster::buildMarchTables(std::uint32_t slot) {
   const PoolLayout& layout = mPool.layout;
   FLIPSCOPE_CHECK(layout.marchTables && slot < layout.slots);
   const std::size_t first = std::size_t(slot) * layout.subBricksPerSlot;
+  std::uint64_t* mask = &mPool.nearSpheres[std::size_t(slot) * nearSphereMaskWords(layout.brickSize)];
   buildNearSphereMask(&mPool.subBricks[first], layout.foam ? &mPool.foamBits[first] : nullptr, layout.brickSize,
-                      layout.overlap, layout.reach,
-                      &mPool.nearSpheres[std::size_t(slot) * nearSphereMaskWords(layout.brickSize)]);
+                      layout.overlap, layout.reach, mask);
+  const std::uint32_t groupsPerEdge = layout.brickSize / kNearGroupCells;
+  std::array<std::uint32_t, 128 * 128 * 128 / 64 / 32> groups;  // of a brick of at most 128^3
+  nearSphereGroups(mask, layout.brickSize, groups.data());
+  buildClearDistances(groups.data(), glm::uvec3(groupsPerEdge),
+                      &mPool.nearDistances[std::size_t(slot) * nearSphereGroupCount(layout.brickSize)]);
   // Level-1 mip bits lead the slot's mip words (bitBrickMipWordOffset(1) = 0).
   buildClearDistances(&mPool.mipWords[std::size_t(slot) * layout.mipWordsPerSlot],
                       bitBrickMipDims(1u, layout.brickSize, layout.overlap), &mPool.clearDistances[first]);

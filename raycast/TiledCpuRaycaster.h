@@ -20,11 +20,14 @@
 //    (NearSphereMask), so that a step into a cell with none skips its slab tests (most steps
 //    near a surface); per sub-brick, the sphere and foam cells of each half, which the
 //    thickness trace (§3.6) and the foam volume (§3.5) read instead of counting bits at every
-//    sample; and per level-1 mip block, the distance to the nearest set one (ClearDistance);
-//  - empty space (§4.2) is skipped by the cube of clear mip blocks centred on the ray's block
+//    sample; and two ClearDistance tables: per level-1 mip block, and per 4^3 cells of the
+//    NearSphereMask, the distance to the nearest set one;
+//  - empty space (§4.2) is skipped by the cube of clear blocks centred on the ray's block
 //    (ClearDistance), one table read, instead of the reference's walk up the mip levels to an
-//    aligned block: half as many skips. The cell met on leaving the cube through a face tests
-//    only its far slab, since no stored cell lies within the reach of the cube.
+//    aligned block. The cubes are of 4^3-cell groups with no sphere near, or of level-1 mip
+//    blocks under the foam volume (whose cells the mask leaves out but the ray gathers). The
+//    cell met on leaving a cube through a face tests only its far slab, since no sphere lies
+//    within the reach of the cube.
 // The rest of the pass (octree descent, requests, foam, attributes, thickness) is
 // Raycast.glsl itself, compiled once more around the new brick march (rcMarchBrick).
 #pragma once

@@ -72,5 +72,37 @@ TEST(NearSphereMask, MatchesTheCellsWithASphereWithinReach) {
   }
 }
 
+TEST(NearSphereMask, GroupsAreSetExactlyWhereOneOfTheirCellsIs) {
+  for (const std::uint32_t brickSize : {32u, 64u, 128u}) {
+    SCOPED_TRACE(brickSize);
+    const std::uint32_t B = brickSize, W = (B + 63) / 64, G = B / kNearGroupCells;
+    std::vector<std::uint64_t> mask(nearSphereMaskWords(B), 0);
+    std::mt19937 random(B);
+    // Single cells, so that a group is set by one cell at any of its 64 places.
+    for (int i = 0; i < int(G * G * G / 3); ++i) {
+      const std::uint32_t x = random() % B, y = random() % B, z = random() % B;
+      mask[(std::size_t(z) * B + y) * W + x / 64] |= std::uint64_t(1) << (x % 64);
+    }
+    std::vector<std::uint32_t> groups((nearSphereGroupCount(B) + 31) / 32, ~0u);
+    nearSphereGroups(mask.data(), B, groups.data());
+    int set = 0, wrong = 0;
+    for (std::uint32_t gz = 0; gz < G; ++gz)
+      for (std::uint32_t gy = 0; gy < G; ++gy)
+        for (std::uint32_t gx = 0; gx < G; ++gx) {
+          bool expected = false;
+          for (std::uint32_t z = gz * 4; z < gz * 4 + 4; ++z)
+            for (std::uint32_t y = gy * 4; y < gy * 4 + 4; ++y)
+              for (std::uint32_t x = gx * 4; x < gx * 4 + 4; ++x)
+                expected |= ((mask[(std::size_t(z) * B + y) * W + x / 64] >> (x % 64)) & 1u) != 0u;
+          const std::size_t i = gx + std::size_t(G) * (gy + std::size_t(G) * gz);
+          set += expected;
+          wrong += (((groups[i / 32] >> (i % 32)) & 1u) != 0u) != expected;
+        }
+    EXPECT_EQ(wrong, 0);
+    EXPECT_GT(set, int(G * G * G / 5));
+    EXPECT_LT(set, int(G * G * G / 2));
+  }
+}
+
 }  // namespace
 }  // namespace flipscope
