@@ -142,7 +142,7 @@ void FramePipeline::init(std::shared_ptr<BrickSource> source,
   if (auto* gpuScreen = dynamic_cast<GpuScreenDevice*>(mScreen.get())) {
     s.hits = gpuScreen->adoptFrameBuffer(&gpu->hitBuffer(), kVec4PerHit);
   } else {
-    const auto& cpu = static_cast<const CpuRaycaster&>(mRenderer->device());
+    auto& cpu = static_cast<CpuRaycaster&>(mRenderer->device());
     s.hits = static_cast<CpuScreenDevice&>(*mScreen).adoptFramePixels(
         [&cpu] {
           const std::vector<RayHit>& hits = cpu.hits();

@@ -115,7 +115,14 @@ std::vector<glm::uvec4> CpuRaycaster::readFoam(std::uint32_t slot) {
 void CpuRaycaster::beginImage(std::uint32_t width, std::uint32_t height) {
   mWidth = width;
   mHeight = height;
-  mHits.assign(std::size_t(width) * height, RayHit{});  // zeros: fresh pending rays
+  mHits.resize(std::size_t(width) * height);
+  mRaysFresh = true;  // the first pass writes every ray (rayAt)
+}
+
+const std::vector<RayHit>& CpuRaycaster::hits() {
+  if (mRaysFresh) std::fill(mHits.begin(), mHits.end(), RayHit{});
+  mRaysFresh = false;
+  return mHits;
 }
 
 std::vector<std::uint32_t> CpuRaycaster::timedPass(
@@ -127,6 +134,7 @@ std::vector<std::uint32_t> CpuRaycaster::timedPass(
       new std::atomic<std::uint8_t>[std::max<std::size_t>(brickCount, 1)]);
   for (std::size_t i = 0; i < brickCount; ++i) flags[i].store(0, std::memory_order_relaxed);
   pass(glsl::RaycastPoolAccess{params, &mPool, flags.get()});
+  mRaysFresh = false;
   std::vector<std::uint32_t> requests;
   for (std::size_t i = 0; i < brickCount; ++i)
     if (flags[i].load(std::memory_order_relaxed)) requests.push_back(std::uint32_t(i));
@@ -140,8 +148,9 @@ std::vector<std::uint32_t> CpuRaycaster::trace(const RaycastParams& params) {
       glsl::RaycastKernel kernel{access};  // the shared functions are non-const members
       for (std::uint32_t y = rows.begin(); y != rows.end(); ++y) {
         for (std::uint32_t x = 0; x < mWidth; ++x) {
-          RayHit& ray = mHits[std::size_t(y) * mWidth + x];
-          if (kernel.rcNeedsPass(ray)) ray = kernel.rcPass(glm::uvec2(x, y), ray);
+          const std::size_t i = std::size_t(y) * mWidth + x;
+          const RayHit ray = rayAt(i);
+          if (kernel.rcNeedsPass(ray)) mHits[i] = kernel.rcPass(glm::uvec2(x, y), ray);
         }
       }
     });

@@ -28,9 +28,10 @@ class CpuRaycaster : public RaycastDevice {
   void beginImage(std::uint32_t width, std::uint32_t height) override;
   std::vector<std::uint32_t> trace(const RaycastParams& params) override;
   double lastTraceMs() const override { return mLastTraceMs; }
-  std::vector<RayHit> readHits() override { return mHits; }
-  /// The image's rays in place, for the passes after the ray-caster.
-  const std::vector<RayHit>& hits() const { return mHits; }
+  std::vector<RayHit> readHits() override { return hits(); }
+  /// The image's rays in place, for the passes after the ray-caster (fresh pending rays before
+  /// the first pass).
+  const std::vector<RayHit>& hits();
 
   /// The pool's arrays, laid out as the GPU's buffers. Slots are left uninitialized until a
   /// brick is uploaded (the page table never points at an empty slot), so a large budget costs
@@ -65,8 +66,14 @@ class CpuRaycaster : public RaycastDevice {
   std::vector<std::uint32_t> timedPass(const RaycastParams& params,
                                        const std::function<void(const glsl::RaycastPoolAccess& access)>& pass);
 
+  /// Ray i as a pass finds it: a fresh pending ray in the first pass after beginImage, which
+  /// leaves the rays unwritten (a fresh ray always needs the pass, which writes it), else
+  /// mHits[i]. timedPass ends the freshness.
+  RayHit rayAt(std::size_t i) const { return mRaysFresh ? RayHit{} : mHits[i]; }
+
   Pool mPool;
   std::vector<RayHit> mHits;
+  bool mRaysFresh = false;  ///< mHits not yet written since beginImage
   std::uint32_t mWidth = 0, mHeight = 0;
 
  private:

@@ -285,8 +285,9 @@ std::vector<std::uint32_t> TiledCpuRaycaster::trace(const RaycastParams& params)
       glsl::TiledRaycastKernel kernel(access, caches.local());
       for (std::uint32_t y = tile.rows().begin(); y != tile.rows().end(); ++y) {
         for (std::uint32_t x = tile.cols().begin(); x != tile.cols().end(); ++x) {
-          RayHit& ray = mHits[std::size_t(y) * mWidth + x];
-          if (kernel.rcNeedsPass(ray)) ray = kernel.rcPass(glm::uvec2(x, y), ray);
+          const std::size_t i = std::size_t(y) * mWidth + x;
+          const RayHit ray = rayAt(i);
+          if (kernel.rcNeedsPass(ray)) mHits[i] = kernel.rcPass(glm::uvec2(x, y), ray);
         }
       }
     });

@@ -22,7 +22,7 @@ FramePipeline cpuPipeline(std::shared_ptr<BrickSource> source) {
 }
 
 const std::vector<RayHit>& hitsOf(FramePipeline& pipeline) {
-  return static_cast<const CpuRaycaster&>(pipeline.renderer().device()).hits();
+  return static_cast<CpuRaycaster&>(pipeline.renderer().device()).hits();
 }
 
 TEST(ProgressiveFrames, AdvancedToTheEndEqualsRender) {
