@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "core/Error.h"
+#include "raycast/ClearDistance.h"
 #include "raycast/NearSphereMask.h"
 #include "streaming/BitBrickLayout.h"
 
@@ -11,7 +12,7 @@ namespace flipscope {
 std::uint64_t PoolLayout::slotBytes() const {
   return std::uint64_t(subBricksPerSlot) * (16 + (attributes ? 4 : 0) + (foam ? 16 : 0) + (marchTables ? 5 : 0)) +
          std::uint64_t(mipWordsPerSlot + (foam ? foamOccupancyWords() : 0)) * 4 +
-         (marchTables ? nearSphereMaskWords(brickSize) * 8 + nearSphereGroupCount(brickSize) : 0);
+         (marchTables ? nearSphereMaskWords(brickSize) * 8 + nearSphereGroupCount(brickSize) + 2 * sizeof(SetBlockBounds) : 0);
 }
 
 PoolLayout PoolLayout::forBudget(std::uint32_t brickSize, std::uint32_t overlap, bool attributes,

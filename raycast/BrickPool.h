@@ -32,7 +32,8 @@ struct PoolLayout {
   /// The fast CPU device's tables (TiledCpuRaycaster; RaycastDevice::keepsMarchTables): per
   /// sub-brick, 4 bytes: the sphere and the foam cells of each of its halves, and a byte: its
   /// ClearDistance; per brick cell, a bit: whether a sphere cell lies within `reach` cells
-  /// (NearSphereMask); per 4^3 cells, a byte: the ClearDistance of the mask's groups.
+  /// (NearSphereMask); per 4^3 cells, a byte: the ClearDistance of the mask's groups; and the
+  /// bounds of both tables' set blocks.
   bool marchTables = false;
   std::uint32_t reach = 0;  ///< of the spheres, in cells (sphereReach), with marchTables
   std::uint32_t slots = 0;

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <vector>
 
+#include <glm/common.hpp>
+
 namespace flipscope {
 
 void buildClearDistances(const std::uint32_t* setBlocks, glm::uvec3 dims, std::uint8_t* distances) {
@@ -45,6 +47,22 @@ void buildClearDistances(const std::uint32_t* setBlocks, glm::uvec3 dims, std::u
   };
   combine(alongX.data(), alongXY.data(), ny, std::size_t(nx));
   combine(alongXY.data(), distances, nz, std::size_t(nx) * ny);
+}
+
+SetBlockBounds setBlockBounds(const std::uint32_t* setBlocks, glm::uvec3 dims) {
+  SetBlockBounds bounds;
+  bounds.lo = glm::ivec3(dims);
+  bounds.hi = glm::ivec3(0);
+  std::size_t i = 0;
+  for (int z = 0; z < int(dims.z); z++)
+    for (int y = 0; y < int(dims.y); y++)
+      for (int x = 0; x < int(dims.x); x++, i++) {
+        if (((setBlocks[i >> 5] >> (i & 31)) & 1u) == 0u) continue;
+        bounds.lo = glm::min(bounds.lo, glm::ivec3(x, y, z));
+        bounds.hi = glm::max(bounds.hi, glm::ivec3(x, y, z) + 1);
+      }
+  if (bounds.hi.x == 0) return SetBlockBounds{};
+  return bounds;
 }
 
 }  // namespace flipscope

@@ -23,4 +23,14 @@ inline constexpr std::uint8_t kMaxClearDistance = 15;
 /// the grid count as clear: the march ends at the brick's face anyway.
 void buildClearDistances(const std::uint32_t* setBlocks, glm::uvec3 dims, std::uint8_t* distances);
 
+/// The blocks [lo, hi) of a grid that hold all its set blocks; lo = hi = 0 when none is set.
+/// Outside them a brick's march has nothing to test, so it starts and ends at their box.
+struct SetBlockBounds {
+  glm::ivec3 lo{0}, hi{0};
+  bool empty() const { return hi.x <= lo.x; }
+};
+
+/// The bounds of the set blocks `setBlocks` (as buildClearDistances) of a grid of `dims`.
+SetBlockBounds setBlockBounds(const std::uint32_t* setBlocks, glm::uvec3 dims);
+
 }  // namespace flipscope

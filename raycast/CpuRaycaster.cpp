@@ -50,6 +50,8 @@ void CpuRaycaster::allocatePool(const PoolLayout& layout) {
   mPool.clearDistances.resize(layout.marchTables ? std::size_t(layout.slots) * layout.subBricksPerSlot : 0);
   mPool.nearDistances.clear();
   mPool.nearDistances.resize(layout.marchTables ? std::size_t(layout.slots) * nearSphereGroupCount(layout.brickSize) : 0);
+  mPool.setBounds.clear();
+  mPool.setBounds.resize(layout.marchTables ? std::size_t(layout.slots) * 2 : 0);
 }
 
 void CpuRaycaster::setOctree(std::span<const OctreeNode> nodes) {

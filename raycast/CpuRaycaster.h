@@ -7,6 +7,7 @@
 #include <functional>
 
 #include "core/UninitializedVector.h"
+#include "raycast/ClearDistance.h"
 #include "raycast/RaycastDevice.h"
 
 namespace flipscope {
@@ -53,9 +54,11 @@ class CpuRaycaster : public RaycastDevice {
     UninitializedVector<std::uint64_t> nearSpheres;
     /// per slot and sub-brick (a level-1 mip block), its ClearDistance;
     UninitializedVector<std::uint8_t> clearDistances;
-    /// and per slot and group of 4^3 brick cells (nearSphereGroups), the ClearDistance of the
-    /// groups with a cell set in the NearSphereMask.
+    /// per slot and group of 4^3 brick cells (nearSphereGroups), the ClearDistance of the
+    /// groups with a cell set in the NearSphereMask;
     UninitializedVector<std::uint8_t> nearDistances;
+    /// and per slot, the bounds of its set level-1 mip blocks, then of its near-sphere groups.
+    std::vector<SetBlockBounds> setBounds;
   };
   const Pool& pool() const { return mPool; }
 

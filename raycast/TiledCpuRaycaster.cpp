@@ -134,6 +134,14 @@ struct TiledRaycastKernel : RaycastPoolAccess {
     const ivec3 blockShift = groups ? ivec3(2) : ivec3(2, 2, 3);
     const ivec3 blockDims = groups ? ivec3(groupsPerEdge) : ivec3(subBrickDims);
     const int blockOrigin = groups ? 0 : overlap;  // the first block's corner is at brick-local -blockOrigin
+    // Outside the box of the set blocks there is nothing to test (nor foam to gather, for the
+    // level-1 blocks): start and end there.
+    const SetBlockBounds bounds = pool->setBounds[std::size_t(slot) * 2 + (groups ? 1 : 0)];
+    if (bounds.empty()) return result;
+    const vec2 span = rcBoxSpan(o, invDir, vec3(bounds.lo * blockCells - ivec3(blockOrigin)),
+                                vec3(bounds.hi * blockCells - ivec3(blockOrigin)));
+    t = max(t, span.x);
+    tEnd = min(tEnd, span.y);
     const float origin[3] = {o.x, o.y, o.z};
     const float inverse[3] = {invDir.x, invDir.y, invDir.z};
     const int step[3] = {dir.x < 0.0f ? -1 : 1, dir.y < 0.0f ? -1 : 1, dir.z < 0.0f ? -1 : 1};
@@ -253,8 +261,11 @@ void TiledCpuRaycaster::buildMarchTables(std::uint32_t slot) {
   buildClearDistances(groups.data(), glm::uvec3(groupsPerEdge),
                       &mPool.nearDistances[std::size_t(slot) * nearSphereGroupCount(layout.brickSize)]);
   // Level-1 mip bits lead the slot's mip words (bitBrickMipWordOffset(1) = 0).
-  buildClearDistances(&mPool.mipWords[std::size_t(slot) * layout.mipWordsPerSlot],
-                      bitBrickMipDims(1u, layout.brickSize, layout.overlap), &mPool.clearDistances[first]);
+  const std::uint32_t* level1 = &mPool.mipWords[std::size_t(slot) * layout.mipWordsPerSlot];
+  const glm::uvec3 level1Dims = bitBrickMipDims(1u, layout.brickSize, layout.overlap);
+  buildClearDistances(level1, level1Dims, &mPool.clearDistances[first]);
+  mPool.setBounds[std::size_t(slot) * 2] = setBlockBounds(level1, level1Dims);
+  mPool.setBounds[std::size_t(slot) * 2 + 1] = setBlockBounds(groups.data(), glm::uvec3(groupsPerEdge));
   for (std::size_t s = first; s < first + layout.subBricksPerSlot; ++s) {
     const glm::uvec4 foam = layout.foam ? mPool.foamBits[s] : glm::uvec4(0);
     const glm::uvec4 liquid = mPool.subBricks[s] & ~foam;

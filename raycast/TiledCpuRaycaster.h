@@ -27,7 +27,8 @@
 //    aligned block. The cubes are of 4^3-cell groups with no sphere near, or of level-1 mip
 //    blocks under the foam volume (whose cells the mask leaves out but the ray gathers). The
 //    cell met on leaving a cube through a face tests only its far slab, since no sphere lies
-//    within the reach of the cube.
+//    within the reach of the cube. A brick's march starts and ends at the box of the set
+//    blocks (SetBlockBounds): a ray that passes over the liquid in a brick tests nothing.
 // The rest of the pass (octree descent, requests, foam, attributes, thickness) is
 // Raycast.glsl itself, compiled once more around the new brick march (rcMarchBrick).
 #pragma once

@@ -7,6 +7,8 @@
 #include <random>
 #include <vector>
 
+#include <glm/common.hpp>
+
 #include "raycast/ClearDistance.h"
 
 namespace flipscope {
@@ -61,6 +63,29 @@ TEST(ClearDistance, ASingleSetBlockGivesRingsAroundIt) {
   EXPECT_EQ(distances[centre - 33 * 33 * 3 + 2], 3);      // z -3, x +2
   EXPECT_EQ(distances[centre + 33 * 14 + 33 * 33 * 8], 14);  // y +14, z +8
   EXPECT_EQ(distances[0], kMaxClearDistance);                 // 16 away
+}
+
+TEST(ClearDistance, SetBlockBoundsHoldEverySetBlockAndNoMore) {
+  std::mt19937 random(11);
+  for (const glm::ivec3 n : {glm::ivec3(17, 17, 9), glm::ivec3(16, 16, 16), glm::ivec3(1, 1, 1)})
+    for (int blocks : {0, 1, 3, 40}) {
+      SCOPED_TRACE(testing::Message() << n.x << "x" << n.y << "x" << n.z << ", " << blocks << " set");
+      const std::size_t count = std::size_t(n.x) * n.y * n.z;
+      std::vector<std::uint32_t> words((count + 31) / 32, 0);
+      glm::ivec3 lo(1 << 20), hi(-1);
+      for (int b = 0; b < blocks; b++) {
+        const glm::ivec3 q(int(random() % n.x), int(random() % n.y), int(random() % n.z));
+        const std::size_t i = std::size_t(q.x + n.x * (q.y + n.y * q.z));
+        words[i >> 5] |= 1u << (i & 31);
+        lo = glm::min(lo, q);
+        hi = glm::max(hi, q + 1);
+      }
+      const SetBlockBounds bounds = setBlockBounds(words.data(), glm::uvec3(n));
+      EXPECT_EQ(bounds.empty(), blocks == 0);
+      if (blocks == 0) continue;
+      EXPECT_EQ(bounds.lo, lo);
+      EXPECT_EQ(bounds.hi, hi);
+    }
 }
 
 }  // namespace
