@@ -73,7 +73,7 @@ struct FramePipeline::Stages {
   ScreenImage rawGbuffer = 0;     ///< depth, mask, thickness, attribute
   ScreenImage gbuffer = 0;        ///< the same with the thickness blurred
   ScreenImage sphereNormals = 0;
-  ScreenImage smoothed = 0;
+  ScreenImage smoothed = 0;       ///< the filter's output; see smoothedDepth()
   ScreenImage normals = 0;
   ScreenImage shaded = 0;
   ScreenImage display = 0;        ///< progressive: what the viewer shows
@@ -82,6 +82,8 @@ struct FramePipeline::Stages {
   std::unique_ptr<SurfaceShading> shading;
   bool thickness = false;         ///< the ray-caster traces the thickness (liquid shading)
   bool litSpheres = false;        ///< spheres shading: the image's normals are the spheres'
+  /// The smoothed depth: the G-buffer itself when the filter keeps the depth (not run).
+  ScreenImage smoothedDepth() const { return filter->keepsDepth() ? gbuffer : smoothed; }
 };
 
 FramePipeline::FramePipeline(BrickStore store, DeviceChoice device, const RenderSettings& settings,
@@ -246,9 +248,9 @@ void FramePipeline::shade(int frame, const Camera& camera, StageTimes& stages) {
     if (s.thickness) device.run(kBlurThickness, nullptr, 0, {s.rawGbuffer}, s.gbuffer);
     device.run(kSphereNormal, nullptr, 0, {s.hits}, s.sphereNormals);
   });
-  timed(stages.smoothing, [&] { s.filter->apply(device, s.gbuffer, s.smoothed); });
+  if (!s.filter->keepsDepth()) timed(stages.smoothing, [&] { s.filter->apply(device, s.gbuffer, s.smoothed); });
   // The spheres shading lights the sphere normals; the surface's are not reconstructed.
-  if (!s.litSpheres) timed(stages.normals, [&] { reconstructNormals(device, s.smoothed, s.normals); });
+  if (!s.litSpheres) timed(stages.normals, [&] { reconstructNormals(device, s.smoothedDepth(), s.normals); });
   // The attribute values of the G-buffer's 0 and 1: the frame's quantization range.
   const StoreHeader& header = mRenderer->source().header();
   const FrameStats stats =
@@ -285,7 +287,7 @@ const FrameOutput& FramePipeline::readOutput() {
     return downloaded[slot];
   };
   const auto gbuffer = read(s.gbuffer, 0);
-  const auto smoothed = read(s.smoothed, 1);
+  const auto smoothed = read(s.smoothedDepth(), 1);
   const auto normals = read(s.litSpheres ? s.sphereNormals : s.normals, 2);
   const std::size_t n = gbuffer.size();
   constexpr float kInf = std::numeric_limits<float>::infinity();

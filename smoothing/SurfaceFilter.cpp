@@ -103,6 +103,7 @@ namespace {
 class NoFilter : public SurfaceFilter {
  public:
   void apply(ScreenDevice& device, ScreenImage depth, ScreenImage output) override { device.copy(depth, output); }
+  bool keepsDepth() const override { return true; }
 };
 }  // namespace
 

@@ -30,6 +30,9 @@ class SurfaceFilter {
   virtual ~SurfaceFilter() = default;
   /// Smooths `depth` into `output` (both frame images on `device`, output not depth).
   virtual void apply(ScreenDevice& device, ScreenImage depth, ScreenImage output) = 0;
+  /// Whether apply() leaves the depth as it is (a copy), so that a caller may read `depth`
+  /// itself and not run it.
+  virtual bool keepsDepth() const { return false; }
 };
 
 /// What `--smoothing NAME` offers, with defaults and the range of each parameter.
