@@ -276,7 +276,11 @@ const FrameOutput& FramePipeline::readOutput() {
   auto* cpu = dynamic_cast<CpuScreenDevice*>(&device);
   if (cpu) {
     const auto shaded = cpu->pixels(s.shaded);
-    image.rgba.assign(shaded.begin(), shaded.end());
+    image.rgba.resize(shaded.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, shaded.size(), 1 << 16),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        std::copy(shaded.begin() + r.begin(), shaded.begin() + r.end(), image.rgba.begin() + r.begin());
+                      });
   } else {
     image.rgba = device.download(s.shaded);
   }

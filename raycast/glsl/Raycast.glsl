@@ -66,8 +66,8 @@ FS_FUNC vec2 rcBoxSpan(vec3 o, vec3 invDir, vec3 lo, vec3 hi) {
 
 // Unit direction of the ray through the centre of `pixel` (row 0 at the top).
 FS_FUNC vec3 rcCameraRay(uvec2 pixel) {
-  float sx = ((float(pixel.x) + 0.5f) / float(P.image.x) * 2.0f - 1.0f) * P.forward.w * P.right.w;
-  float sy = (1.0f - (float(pixel.y) + 0.5f) / float(P.image.y) * 2.0f) * P.forward.w;
+  float sx = ((float(pixel.x) + 0.5f) * (2.0f / float(P.image.x)) - 1.0f) * P.forward.w * P.right.w;
+  float sy = (1.0f - (float(pixel.y) + 0.5f) * (2.0f / float(P.image.y))) * P.forward.w;
   vec3 f = vec3(P.forward.x, P.forward.y, P.forward.z);
   vec3 r = vec3(P.right.x, P.right.y, P.right.z);
   vec3 u = vec3(P.up.x, P.up.y, P.up.z);
@@ -368,7 +368,8 @@ FS_FUNC RayHit rcTrace(uvec2 pixel, RayHit ray) {
   for (uint step = 0u; step < kRaycastMaxSteps; step++) {
     if (t > domain.y) return result;
     vec3 p = eye + t * dir;
-    uvec3 brick = uvec3(clamp(ivec3(floor(p / float(B))), ivec3(0), ivec3(P.grid.x, P.grid.y, P.grid.z) - ivec3(1)));
+    // B is a power of two: multiplying by 1 / B is exact, and cheaper than dividing.
+    uvec3 brick = uvec3(clamp(ivec3(floor(p * (1.0f / float(B)))), ivec3(0), ivec3(P.grid.x, P.grid.y, P.grid.z) - ivec3(1)));
     // 1. Descend the presence octree to the brick, or to the empty octant holding the point.
     uint node = 0u;
     uvec3 origin = uvec3(0u);
