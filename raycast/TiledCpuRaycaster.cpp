@@ -104,10 +104,10 @@ struct TiledRaycastKernel : RaycastPoolAccess {
   /// without a sphere near (the slot's NearSphereMask) tests none. A cube of clear blocks
   /// (ClearDistance) is crossed at once; no sphere lies within k of it (the mipmap's dilation is
   /// the reach, buildBrickMipmap), so the cell a ray meets on leaving one through a face tests
-  /// only its far slab, as after a step; through an edge or a corner, its whole neighbourhood. The DDA's state is kept in scalar
-  /// arrays (a vector indexed by a run-time axis goes through memory). The vectors come by
-  /// reference: by value, rcTrace stored them in halves and the call read them whole, a stalled
-  /// store per brick (2% of the trace).
+  /// only its far slab, as after a step; through an edge or a corner, its whole neighbourhood.
+  /// The DDA's state is kept in scalar arrays (a vector indexed by a run-time axis goes through
+  /// memory). The vectors come by reference: by value, rcTrace stored them in halves and the
+  /// call read them whole, a stalled store per brick (2% of the trace).
   RayHit rcMarchBrick(RayHit result, uint slot, const uvec3& brick, const vec3& eye, const vec3& dir, float t,
                       float tEnd) {
     const uvec3 brickCell = brick * uvec3(uint(B));
