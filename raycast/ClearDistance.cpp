@@ -30,13 +30,15 @@ void buildClearDistances(const std::uint32_t* setBlocks, glm::uvec3 dims, std::u
         alongX[i] = std::uint8_t(d);
       }
     }
-  // One more axis: out[b] = min over offsets j of max(|j|, in[b + j along the axis]).
-  auto combine = [&](const std::uint8_t* in, std::uint8_t* out, int n, std::size_t stride) {
+  // One more axis (1: y, 2: z): out[b] = min over offsets j of max(|j|, in[b + j along it]).
+  auto combine = [&](const std::uint8_t* in, std::uint8_t* out, int axis) {
+    const int n = axis == 1 ? ny : nz;
+    const std::size_t stride = axis == 1 ? std::size_t(nx) : std::size_t(nx) * ny;
     for (int z = 0; z < nz; z++)
       for (int y = 0; y < ny; y++)
         for (int x = 0; x < nx; x++) {
           const std::size_t i = at(x, y, z);
-          const int c = stride == std::size_t(nx) ? y : z;
+          const int c = axis == 1 ? y : z;
           int d = in[i];
           for (int j = 1; j < d; j++) {
             if (c - j >= 0) d = std::min(d, std::max<int>(j, in[i - j * stride]));
@@ -45,8 +47,8 @@ void buildClearDistances(const std::uint32_t* setBlocks, glm::uvec3 dims, std::u
           out[i] = std::uint8_t(d);
         }
   };
-  combine(alongX.data(), alongXY.data(), ny, std::size_t(nx));
-  combine(alongXY.data(), distances, nz, std::size_t(nx) * ny);
+  combine(alongX.data(), alongXY.data(), 1);
+  combine(alongXY.data(), distances, 2);
 }
 
 SetBlockBounds setBlockBounds(const std::uint32_t* setBlocks, glm::uvec3 dims) {

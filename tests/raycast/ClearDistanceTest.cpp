@@ -31,9 +31,10 @@ std::vector<std::uint8_t> bruteForce(const std::vector<bool>& set, glm::ivec3 n)
 }
 
 TEST(ClearDistance, IsTheChebyshevDistanceToTheNearestSetBlock) {
-  // Dims of a 64^3 brick with overlap 1 (17x17x9), a 128^3 one (33x33x17), and odd shapes; from
-  // none set to most set, so that distances run from 0 to the cap.
-  const glm::ivec3 shapes[] = {{17, 17, 9}, {33, 33, 17}, {1, 1, 1}, {5, 40, 3}};
+  // Dims of a 64^3 brick with overlap 1 (17x17x9), a 128^3 one (33x33x17), and odd shapes (one
+  // a single block deep in y, where the y and z strides are equal); from none set to most set,
+  // so that distances run from 0 to the cap.
+  const glm::ivec3 shapes[] = {{17, 17, 9}, {33, 33, 17}, {1, 1, 1}, {5, 40, 3}, {6, 1, 20}};
   const double densities[] = {0.0, 0.0005, 0.01, 0.2, 0.9};
   std::mt19937 random(7);
   for (const glm::ivec3 n : shapes)
