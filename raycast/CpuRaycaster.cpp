@@ -51,7 +51,7 @@ void CpuRaycaster::allocatePool(const PoolLayout& layout) {
   mPool.nearDistances.clear();
   mPool.nearDistances.resize(layout.marchTables ? std::size_t(layout.slots) * nearSphereGroupCount(layout.brickSize) : 0);
   mPool.setBounds.clear();
-  mPool.setBounds.resize(layout.marchTables ? std::size_t(layout.slots) * 2 : 0);
+  mPool.setBounds.resize(layout.marchTables ? layout.slots : 0);
 }
 
 void CpuRaycaster::setOctree(std::span<const OctreeNode> nodes) {

@@ -57,8 +57,11 @@ class CpuRaycaster : public RaycastDevice {
     /// per slot and group of 4^3 brick cells (nearSphereGroups), the ClearDistance of the
     /// groups with a cell set in the NearSphereMask;
     UninitializedVector<std::uint8_t> nearDistances;
-    /// and per slot, the bounds of its set level-1 mip blocks, then of its near-sphere groups.
-    std::vector<SetBlockBounds> setBounds;
+    /// and per slot, the bounds of the set blocks of both tables.
+    struct SetBounds {
+      SetBlockBounds mipBlocks, nearGroups;
+    };
+    std::vector<SetBounds> setBounds;
   };
   const Pool& pool() const { return mPool; }
 

@@ -136,7 +136,7 @@ struct TiledRaycastKernel : RaycastPoolAccess {
     const int blockOrigin = groups ? 0 : overlap;  // the first block's corner is at brick-local -blockOrigin
     // Outside the box of the set blocks there is nothing to test (nor foam to gather, for the
     // level-1 blocks): start and end there.
-    const SetBlockBounds bounds = pool->setBounds[std::size_t(slot) * 2 + (groups ? 1 : 0)];
+    const SetBlockBounds bounds = groups ? pool->setBounds[slot].nearGroups : pool->setBounds[slot].mipBlocks;
     if (bounds.empty()) return result;
     const vec2 span = rcBoxSpan(o, invDir, vec3(bounds.lo * blockCells - ivec3(blockOrigin)),
                                 vec3(bounds.hi * blockCells - ivec3(blockOrigin)));
@@ -264,8 +264,7 @@ void TiledCpuRaycaster::buildMarchTables(std::uint32_t slot) {
   const std::uint32_t* level1 = &mPool.mipWords[std::size_t(slot) * layout.mipWordsPerSlot];
   const glm::uvec3 level1Dims = bitBrickMipDims(1u, layout.brickSize, layout.overlap);
   buildClearDistances(level1, level1Dims, &mPool.clearDistances[first]);
-  mPool.setBounds[std::size_t(slot) * 2] = setBlockBounds(level1, level1Dims);
-  mPool.setBounds[std::size_t(slot) * 2 + 1] = setBlockBounds(groups.data(), glm::uvec3(groupsPerEdge));
+  mPool.setBounds[slot] = {setBlockBounds(level1, level1Dims), setBlockBounds(groups.data(), glm::uvec3(groupsPerEdge))};
   for (std::size_t s = first; s < first + layout.subBricksPerSlot; ++s) {
     const glm::uvec4 foam = layout.foam ? mPool.foamBits[s] : glm::uvec4(0);
     const glm::uvec4 liquid = mPool.subBricks[s] & ~foam;
