@@ -1,5 +1,5 @@
 // ClearDistance against brute force: each block's Chebyshev distance, in blocks, to the nearest
-// set level-1 mip block (0 when set), capped at kMaxClearDistance.
+// set block (0 when set), capped at kMaxClearDistance; and the bounds of the set blocks.
 #include <gtest/gtest.h>
 
 #include <algorithm>
