@@ -32,10 +32,8 @@ double msSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-const ScreenPass kSurface{"GBuffer.comp", "gbufferSurface",
-                          cpuScreenPass<glsl::GBufferKernel, &glsl::GBufferKernel::gbufferSurface>};
-const ScreenPass kSphereNormal{"GBuffer.comp", "gbufferSphereNormal",
-                               cpuScreenPass<glsl::GBufferKernel, &glsl::GBufferKernel::gbufferSphereNormal>};
+const ScreenPass kHits{"GBufferHits.comp", "gbufferHits",
+                       cpuScreenPass<glsl::GBufferKernel, &glsl::GBufferKernel::gbufferHits>};
 const ScreenPass kBlurThickness{"GBuffer.comp", "gbufferBlurThickness",
                                 cpuScreenPass<glsl::GBufferKernel, &glsl::GBufferKernel::gbufferBlurThickness>};
 }  // namespace
@@ -244,9 +242,8 @@ void FramePipeline::shade(int frame, const Camera& camera, StageTimes& stages) {
   };
   device.setFrame(screenFrame(camera));
   timed(stages.gbuffer, [&] {
-    device.run(kSurface, nullptr, 0, {s.hits}, s.thickness ? s.rawGbuffer : s.gbuffer);
+    device.runPair(kHits, nullptr, 0, {s.hits}, s.thickness ? s.rawGbuffer : s.gbuffer, s.sphereNormals);
     if (s.thickness) device.run(kBlurThickness, nullptr, 0, {s.rawGbuffer}, s.gbuffer);
-    device.run(kSphereNormal, nullptr, 0, {s.hits}, s.sphereNormals);
   });
   if (!s.filter->keepsDepth()) timed(stages.smoothing, [&] { s.filter->apply(device, s.gbuffer, s.smoothed); });
   // The spheres shading lights the sphere normals; the surface's are not reconstructed.

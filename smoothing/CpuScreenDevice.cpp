@@ -68,20 +68,37 @@ std::vector<glm::vec4> CpuScreenDevice::download(ScreenImage handle) {
 
 void CpuScreenDevice::run(const ScreenPass& pass, const void* params, std::size_t,
                           std::initializer_list<ScreenImage> inputs, ScreenImage output) {
+  dispatch(pass, params, inputs, {output});
+}
+
+void CpuScreenDevice::runPair(const ScreenPass& pass, const void* params, std::size_t,
+                              std::initializer_list<ScreenImage> inputs, ScreenImage output,
+                              ScreenImage secondOutput) {
+  FLIPSCOPE_CHECK(output != secondOutput, pass.kernel << ": both outputs are one image");
+  dispatch(pass, params, inputs, {output, secondOutput});
+}
+
+void CpuScreenDevice::dispatch(const ScreenPass& pass, const void* params, std::initializer_list<ScreenImage> inputs,
+                               std::initializer_list<ScreenImage> outputs) {
   FLIPSCOPE_CHECK(inputs.size() <= 4, pass.kernel << ": " << inputs.size() << " inputs");
   CpuPassInputs in;
   in.frame = mFrame;
   int slot = 0;
   for (ScreenImage handle : inputs) {
-    FLIPSCOPE_CHECK(handle != output, pass.kernel << ": the output is also an input");
+    for (ScreenImage output : outputs) FLIPSCOPE_CHECK(handle != output, pass.kernel << ": an output is also an input");
     const auto pixels = read(handle);
     in.images[slot] = pixels.data();
     in.sizes[slot] = pixels.size();
     ++slot;
   }
-  Image& out = target(output);
-  FLIPSCOPE_CHECK(out.perPixel == 1, pass.kernel << ": the output must be a frame image");
-  pass.cpu(in, params, out.data.data());
+  glm::vec4* out[2] = {};
+  int written = 0;
+  for (ScreenImage output : outputs) {
+    Image& image = target(output);
+    FLIPSCOPE_CHECK(image.perPixel == 1, pass.kernel << ": an output must be a frame image");
+    out[written++] = image.data.data();
+  }
+  pass.cpu(in, params, out[0], out[1]);
 }
 
 void CpuScreenDevice::clear(ScreenImage handle) {

@@ -23,6 +23,8 @@ class CpuScreenDevice : public ScreenDevice {
   void copy(ScreenImage from, ScreenImage to) override;
   void run(const ScreenPass& pass, const void* params, std::size_t paramBytes,
            std::initializer_list<ScreenImage> inputs, ScreenImage output) override;
+  void runPair(const ScreenPass& pass, const void* params, std::size_t paramBytes,
+               std::initializer_list<ScreenImage> inputs, ScreenImage output, ScreenImage secondOutput) override;
 
   /// The image's elements in place (no copy), for callers on the CPU; not of an adopted image.
   std::span<glm::vec4> pixels(ScreenImage image);
@@ -40,6 +42,9 @@ class CpuScreenDevice : public ScreenDevice {
   /// An image that is written to (not adopted).
   Image& target(ScreenImage handle);
   std::span<const glm::vec4> read(ScreenImage handle);
+  /// run and runPair; `outputs` holds one image or two.
+  void dispatch(const ScreenPass& pass, const void* params, std::initializer_list<ScreenImage> inputs,
+                std::initializer_list<ScreenImage> outputs);
   std::vector<Image> mImages;
 };
 

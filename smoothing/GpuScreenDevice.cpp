@@ -6,8 +6,8 @@
 namespace flipscope {
 
 namespace {
-// Binding points of smoothing/glsl/ScreenPass.glsl.
-constexpr GLuint kFrameBlock = 0, kPassBlock = 1, kFirstInput = 2, kOutput = 6;
+// Binding points of smoothing/glsl/ScreenPass.glsl (and ScreenPairPassMain.glsl's second output).
+constexpr GLuint kFrameBlock = 0, kPassBlock = 1, kFirstInput = 2, kOutput = 6, kSecondOutput = 7;
 constexpr std::uint32_t kGroupSize = 8;     // local_size_x and _y of ScreenPass.glsl
 constexpr std::size_t kPassBlockBytes = 1024;  // larger than any pass's parameter struct
 
@@ -94,6 +94,18 @@ const gl::Program& GpuScreenDevice::program(const ScreenPass& pass) {
 
 void GpuScreenDevice::run(const ScreenPass& pass, const void* params, std::size_t paramBytes,
                           std::initializer_list<ScreenImage> inputs, ScreenImage output) {
+  dispatch(pass, params, paramBytes, inputs, {output});
+}
+
+void GpuScreenDevice::runPair(const ScreenPass& pass, const void* params, std::size_t paramBytes,
+                              std::initializer_list<ScreenImage> inputs, ScreenImage output,
+                              ScreenImage secondOutput) {
+  FLIPSCOPE_CHECK(output != secondOutput, pass.kernel << ": both outputs are one image");
+  dispatch(pass, params, paramBytes, inputs, {output, secondOutput});
+}
+
+void GpuScreenDevice::dispatch(const ScreenPass& pass, const void* params, std::size_t paramBytes,
+                               std::initializer_list<ScreenImage> inputs, std::initializer_list<ScreenImage> outputs) {
   FLIPSCOPE_CHECK(inputs.size() <= 4 && paramBytes <= kPassBlockBytes, pass.kernel);
   const gl::Program& prog = program(pass);
   if (paramBytes) mPassBlock.upload(0, params, paramBytes);
@@ -102,16 +114,19 @@ void GpuScreenDevice::run(const ScreenPass& pass, const void* params, std::size_
   GLuint binding = kFirstInput;
   const gl::Buffer* first = nullptr;
   for (ScreenImage handle : inputs) {
-    FLIPSCOPE_CHECK(handle != output, pass.kernel << ": the output is also an input");
+    for (ScreenImage output : outputs) FLIPSCOPE_CHECK(handle != output, pass.kernel << ": an output is also an input");
     const gl::Buffer& buffer = image(handle).buffer();
     if (!first) first = &buffer;
     buffer.bindBase(GL_SHADER_STORAGE_BUFFER, binding++);
   }
   // Unused inputs are bound to a valid buffer (a shader never reads them).
   for (; binding < kOutput; ++binding) (first ? *first : mPassBlock).bindBase(GL_SHADER_STORAGE_BUFFER, binding);
-  Image& target = image(output);
-  FLIPSCOPE_CHECK(target.perPixel == 1 && !target.adopted, pass.kernel << ": the output must be an owned frame image");
-  target.owned.bindBase(GL_SHADER_STORAGE_BUFFER, kOutput);
+  GLuint outputBinding = kOutput;
+  for (ScreenImage output : outputs) {
+    Image& target = image(output);
+    FLIPSCOPE_CHECK(target.perPixel == 1 && !target.adopted, pass.kernel << ": an output must be an owned frame image");
+    target.owned.bindBase(GL_SHADER_STORAGE_BUFFER, outputBinding++);
+  }
   prog.use();
   prog.dispatch((width() + kGroupSize - 1) / kGroupSize, (height() + kGroupSize - 1) / kGroupSize, 1);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT);

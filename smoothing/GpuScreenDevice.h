@@ -33,6 +33,8 @@ class GpuScreenDevice : public ScreenDevice {
   void copy(ScreenImage from, ScreenImage to) override;
   void run(const ScreenPass& pass, const void* params, std::size_t paramBytes,
            std::initializer_list<ScreenImage> inputs, ScreenImage output) override;
+  void runPair(const ScreenPass& pass, const void* params, std::size_t paramBytes,
+               std::initializer_list<ScreenImage> inputs, ScreenImage output, ScreenImage secondOutput) override;
   void finish() override;
   /// The shader storage buffer behind `image` (the viewer copies its display image from it).
   const gl::Buffer& buffer(ScreenImage image) const;
@@ -47,6 +49,9 @@ class GpuScreenDevice : public ScreenDevice {
   };
   Image& image(ScreenImage handle);
   const gl::Program& program(const ScreenPass& pass);
+  /// run and runPair; `outputs` holds one image or two.
+  void dispatch(const ScreenPass& pass, const void* params, std::size_t paramBytes,
+                std::initializer_list<ScreenImage> inputs, std::initializer_list<ScreenImage> outputs);
 
   std::string mName;
   std::vector<Image> mImages;

@@ -31,12 +31,15 @@ struct CpuPassInputs;
 
 /// One per-pixel kernel: on the GPU the embedded compute shader `shader` with FS_KERNEL defined as
 /// `kernel`; on the CPU `cpu`, the same kernel compiled as C++ (see detail/CpuScreenKernel.h).
+/// A kernel returns a vec4 (ScreenDevice::run), or a ScreenPair (runPair; its .comp includes
+/// ScreenPairPassMain.glsl).
 struct ScreenPass {
   std::string_view shader;  ///< embedded .comp, e.g. "Rof.comp"
   std::string_view kernel;  ///< its kernel function, e.g. "rofDual"
-  /// Writes the kernel's value for every pixel of the frame into `output`; `params` is the
-  /// pass's parameter struct (the block at binding 1).
-  void (*cpu)(const CpuPassInputs& inputs, const void* params, glm::vec4* output);
+  /// Writes the kernel's value for every pixel of the frame into `output` (a pair's first value;
+  /// its second into `secondOutput`, null for a vec4 kernel); `params` is the pass's parameter
+  /// struct (the block at binding 1).
+  void (*cpu)(const CpuPassInputs& inputs, const void* params, glm::vec4* output, glm::vec4* secondOutput);
 };
 
 class ScreenDevice {
@@ -67,6 +70,11 @@ class ScreenDevice {
   /// the inputs). `params` is the pass's parameter struct of `paramBytes` bytes.
   virtual void run(const ScreenPass& pass, const void* params, std::size_t paramBytes,
                    std::initializer_list<ScreenImage> inputs, ScreenImage output) = 0;
+  /// As run, for a pass whose kernel returns a ScreenPair: its first value goes to `output`, its
+  /// second to `secondOutput` (frame-sized, neither an input nor `output`). Where two values of a
+  /// pixel come from the same inputs, one pass reads them once.
+  virtual void runPair(const ScreenPass& pass, const void* params, std::size_t paramBytes,
+                       std::initializer_list<ScreenImage> inputs, ScreenImage output, ScreenImage secondOutput) = 0;
   /// Waits until every pass issued so far has finished (for timing stages).
   virtual void finish() {}
 
@@ -74,6 +82,11 @@ class ScreenDevice {
   void run(const ScreenPass& pass, const Params& params, std::initializer_list<ScreenImage> inputs,
            ScreenImage output) {
     run(pass, &params, sizeof(Params), inputs, output);
+  }
+  template <class Params>
+  void runPair(const ScreenPass& pass, const Params& params, std::initializer_list<ScreenImage> inputs,
+               ScreenImage output, ScreenImage secondOutput) {
+    runPair(pass, &params, sizeof(Params), inputs, output, secondOutput);
   }
 
  protected:

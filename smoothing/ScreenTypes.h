@@ -12,6 +12,7 @@ namespace flipscope::glsl {
 
 namespace flipscope {
 using glsl::ScreenFrame;
+using glsl::ScreenPair;
 
 static_assert(sizeof(ScreenFrame) == 6 * 16);
 static_assert(offsetof(ScreenFrame, forward) == 16 && offsetof(ScreenFrame, worldUp) == 64 &&

@@ -1,4 +1,4 @@
-// G-buffer passes: FS_KERNEL is gbufferSurface or gbufferSphereNormal (GBuffer.glsl).
+// The G-buffer pass over its own image: FS_KERNEL is gbufferBlurThickness (GBuffer.glsl).
 #include "ScreenTypes.glsl"
 #include "RaycastTypes.glsl"
 #include "ScreenPass.glsl"

@@ -1,29 +1,28 @@
 // The ray-caster's hits as the G-buffer of the screen-space stages (Reichl et al. 2014 §3.3,
-// Fig. 3). Shared by GBuffer.comp and FramePipeline.cpp. Input 0 is the RayHit array
+// Fig. 3). Shared by GBufferHits.comp, GBuffer.comp and FramePipeline.cpp. Input 0 is the RayHit array
 // (raycast/glsl/RaycastTypes.glsl) read as three vec4 per pixel: normal and attribute; t,
 // status, depth, brick; thickness, foam opacity and two unused floats.
 
-// gbufferSurface -> x: linear depth (world units; 0 on the background), y: mask, z: thickness
-// (world units), w: attribute.
-FS_FUNC vec4 gbufferSurface(ivec2 p) {
-  uint i = uint(p.y) * F.size.x + uint(p.x);
-  vec4 normal = ssLoadIndex(0u, 3u * i);
-  vec4 ray = ssLoadIndex(0u, 3u * i + 1u);
-  vec4 extra = ssLoadIndex(0u, 3u * i + 2u);
-  if (floatBitsToUint(ray.y) != kRayHit) return vec4(0.0f);
-  return vec4(ray.z, 1.0f, max(extra.x, 0.0f), normal.w);
-}
-
-// gbufferSphereNormal -> xyz: the sphere normal of the hit (world; 0 on the background), w: the
-// opacity of the volumetric foam in front of it, or along the ray on the background (§3.5).
-FS_FUNC vec4 gbufferSphereNormal(ivec2 p) {
+// gbufferHits (GBufferHits.comp, two outputs) -> first, the surface: x: linear depth (world
+// units; 0 on the background), y: mask, z: thickness (world units), w: attribute; second, the
+// sphere: xyz: the sphere normal of the hit (world; 0 on the background), w: the opacity of the
+// volumetric foam in front of it, or along the ray on the background (§3.5). One pass reads the
+// hits (48 bytes a pixel) once for both.
+FS_FUNC ScreenPair gbufferHits(ivec2 p) {
   uint i = uint(p.y) * F.size.x + uint(p.x);
   vec4 normal = ssLoadIndex(0u, 3u * i);
   vec4 ray = ssLoadIndex(0u, 3u * i + 1u);
   vec4 extra = ssLoadIndex(0u, 3u * i + 2u);
   float foam = clamp(extra.y, 0.0f, 1.0f);
-  if (floatBitsToUint(ray.y) != kRayHit) return vec4(0.0f, 0.0f, 0.0f, foam);
-  return vec4(normal.x, normal.y, normal.z, foam);
+  ScreenPair texels;
+  if (floatBitsToUint(ray.y) != kRayHit) {
+    texels.first = vec4(0.0f);
+    texels.second = vec4(0.0f, 0.0f, 0.0f, foam);
+  } else {
+    texels.first = vec4(ray.z, 1.0f, max(extra.x, 0.0f), normal.w);
+    texels.second = vec4(normal.x, normal.y, normal.z, foam);
+  }
+  return texels;
 }
 
 // gbufferBlurThickness (input 0: the gbufferSurface image) -> the same with its thickness

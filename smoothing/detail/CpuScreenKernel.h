@@ -11,6 +11,8 @@
 //   const ScreenPass kRofDual{"Rof.comp", "rofDual", cpuScreenPass<glsl::RofKernel, &glsl::RofKernel::rofDual>};
 #pragma once
 
+#include <type_traits>
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -39,10 +41,13 @@ struct CpuScreenKernel {
 
 namespace flipscope {
 
-/// ScreenPass::cpu for kernel `Fn` of `Kernel` (a CpuScreenKernel with a parameter member S):
-/// one TBB task per band of rows.
-template <class Kernel, glm::vec4 (Kernel::*Fn)(glm::ivec2)>
-void cpuScreenPass(const CpuPassInputs& inputs, const void* params, glm::vec4* output) {
+/// ScreenPass::cpu for kernel `Fn` of `Kernel` (a CpuScreenKernel with a parameter member S),
+/// which returns a vec4 or a ScreenPair: one TBB task per band of rows.
+template <class Kernel, auto Fn>
+void cpuScreenPass(const CpuPassInputs& inputs, const void* params, glm::vec4* output, glm::vec4* secondOutput) {
+  constexpr bool pair = std::is_same_v<std::invoke_result_t<decltype(Fn), Kernel&, glm::ivec2>, ScreenPair>;
+  FLIPSCOPE_CHECK(pair == (secondOutput != nullptr),
+                  (pair ? "a pass of two outputs run with one" : "a pass of one output run with two"));
   Kernel prototype;
   prototype.F = inputs.frame;
   prototype.in = &inputs;
@@ -50,9 +55,18 @@ void cpuScreenPass(const CpuPassInputs& inputs, const void* params, glm::vec4* o
   const std::uint32_t width = inputs.frame.size.x, height = inputs.frame.size.y;
   tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, height), [&](const tbb::blocked_range<std::uint32_t>& rows) {
     Kernel kernel = prototype;
-    for (std::uint32_t y = rows.begin(); y != rows.end(); ++y)
-      for (std::uint32_t x = 0; x < width; ++x)
-        output[std::size_t(y) * width + x] = (kernel.*Fn)(glm::ivec2(int(x), int(y)));
+    for (std::uint32_t y = rows.begin(); y != rows.end(); ++y) {
+      for (std::uint32_t x = 0; x < width; ++x) {
+        const std::size_t i = std::size_t(y) * width + x;
+        if constexpr (pair) {
+          const ScreenPair values = (kernel.*Fn)(glm::ivec2(int(x), int(y)));
+          output[i] = values.first;
+          secondOutput[i] = values.second;
+        } else {
+          output[i] = (kernel.*Fn)(glm::ivec2(int(x), int(y)));
+        }
+      }
+    }
   });
 }
 

@@ -1,7 +1,8 @@
 // GPU side of a screen-space pass: the frame block, four input images and the output image, at
 // the binding points smoothing/GpuScreenDevice.cpp binds. A pass's .comp includes, in order:
 // ScreenTypes.glsl, its own parameter struct and `layout(std140, binding = 1) uniform PassBlock
-// { ItsParams S; };`, this file, its kernels (shared with C++), then ScreenPassMain.glsl.
+// { ItsParams S; };`, this file, its kernels (shared with C++), then ScreenPassMain.glsl, or
+// ScreenPairPassMain.glsl for a kernel that returns a ScreenPair.
 // The C++ side of the same accessors is smoothing/detail/CpuScreenKernel.h.
 layout(local_size_x = 8, local_size_y = 8) in;
 

@@ -17,3 +17,10 @@ struct ScreenFrame {
   float cellSize;        // world units
   float unused0;
 };
+
+// What the kernel of a two-output pass returns (ScreenDevice::runPair): `first` goes to its
+// output, `second` to its second output.
+struct ScreenPair {
+  vec4 first;
+  vec4 second;
+};
