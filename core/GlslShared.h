@@ -4,6 +4,8 @@
 //
 // Rules for shared .glsl files:
 //  - functions are declared `FS_FUNC uint f(uint x)`; FS_FUNC is `inline` in C++, empty in GLSL;
+//  - a parameter the function updates in place is `FS_INOUT(T) name`: `inout T` in GLSL, `T&` in
+//    C++ (GLSL copies it in and out, C++ updates the caller's; the same when nothing else aliases it);
 //  - only uint/int/float/bool and GLM/GLSL vector types; unsigned literals carry a `u`;
 //  - no GLSL-only built-ins except those mirrored below (bitCount, ...);
 //  - C++ includes them inside `namespace flipscope::glsl` through this header.
@@ -18,6 +20,7 @@
 #include "core/FastFloor.h"
 
 #define FS_FUNC inline
+#define FS_INOUT(T) T&
 
 namespace flipscope::glsl {
 using uint = std::uint32_t;

@@ -70,7 +70,7 @@ void append(std::string& out, const embedded::TextFile& file, std::set<std::stri
 std::string shaderSource(std::string_view fileName, std::string_view defines) {
   const embedded::TextFile* file = findFile(fileName);
   if (!file) throw std::runtime_error("unknown shader file \"" + std::string(fileName) + "\" (not embedded)");
-  std::string out = "#version 450 core\n#define FS_FUNC\n";
+  std::string out = "#version 450 core\n#define FS_FUNC\n#define FS_INOUT(T) inout T\n";
   out.append(defines);
   if (!defines.empty() && defines.back() != '\n') out += '\n';
   std::set<std::string_view> pasted;

@@ -9,7 +9,8 @@
 namespace flipscope::gl {
 
 /// The embedded file `fileName` (a basename, e.g. "Raycast.comp") as a complete compute-shader
-/// source: "#version 450 core\n#define FS_FUNC\n" (FS_FUNC: core/GlslShared.h), then `defines`
+/// source: "#version 450 core\n#define FS_FUNC\n#define FS_INOUT(T) inout T\n" (see
+/// core/GlslShared.h), then `defines`
 /// (lines such as "#define FS_KERNEL rofDual"), then the file
 /// with every `#include "Name.glsl"` line replaced by that embedded file, found by basename
 /// (a path before it is ignored), recursively. Each file is pasted at most once; a repeated

@@ -41,8 +41,8 @@ struct RaycastPoolAccess {
 struct RaycastKernel : RaycastPoolAccess {
   uint rcLiquidHalfCount(uint slot, uvec2 h) { return rcLiquidHalfCountOfBits(slot, h); }
   uint rcFoamHalfCount(uint slot, uvec2 h) { return rcFoamHalfCountOfBits(slot, h); }
-  RayHit rcMarchBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t, float tEnd) {
-    return rcTraceBrick(result, slot, brick, eye, dir, t, tEnd);
+  void rcMarchBrick(RayHit& result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t, float tEnd) {
+    rcTraceBrick(result, slot, brick, eye, dir, t, tEnd);
   }
 
 #include "raycast/glsl/Raycast.glsl"

@@ -151,8 +151,10 @@ std::vector<std::uint32_t> CpuRaycaster::trace(const RaycastParams& params) {
       for (std::uint32_t y = rows.begin(); y != rows.end(); ++y) {
         for (std::uint32_t x = 0; x < mWidth; ++x) {
           const std::size_t i = std::size_t(y) * mWidth + x;
-          const RayHit ray = rayAt(i);
-          if (kernel.rcNeedsPass(ray)) mHits[i] = kernel.rcPass(glm::uvec2(x, y), ray);
+          RayHit ray = rayAt(i);
+          if (!kernel.rcNeedsPass(ray)) continue;
+          kernel.rcPass(glm::uvec2(x, y), ray);
+          mHits[i] = ray;
         }
       }
     });

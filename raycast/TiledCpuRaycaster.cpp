@@ -106,17 +106,10 @@ struct TiledRaycastKernel : RaycastPoolAccess {
   /// the reach, buildBrickMipmap), so the cell a ray meets on leaving one through a face tests
   /// only its far slab, as after a step; through an edge or a corner, its whole neighbourhood.
   /// The DDA's state is kept in scalar arrays (a vector indexed by a run-time axis goes through
-  /// memory). The ray and the vectors come by reference, and the ray is copied only on return:
-  /// by value, rcTrace stored them in parts just before the call and the call read them whole,
-  /// and such a load waits until those stores (and the hits written before them) reach the cache.
-  RayHit rcMarchBrick(const RayHit& ray, uint slot, const uvec3& brick, const vec3& eye, const vec3& dir, float t,
-                      float tEnd) {
-    float foamInFront = ray.foam;  // as the march adds to it
-    auto result = [&] {
-      RayHit r = ray;
-      r.foam = foamInFront;
-      return r;
-    };
+  /// memory). The vectors come by reference: by value, rcTrace stored them in parts just before
+  /// the call and the call read them whole, and such a load waits for those stores.
+  void rcMarchBrick(RayHit& ray, uint slot, const uvec3& brick, const vec3& eye, const vec3& dir, float t,
+                    float tEnd) {
     const uvec3 brickCell = brick * uvec3(uint(B));
     const vec3 o = eye - vec3(brickCell);
     const vec3 invDir = rcSafeInverse(dir);
@@ -144,7 +137,7 @@ struct TiledRaycastKernel : RaycastPoolAccess {
     // Outside the box of the set blocks there is nothing to test (nor foam to gather, for the
     // level-1 blocks): start and end there.
     const SetBlockBounds bounds = groups ? pool->setBounds[slot].nearGroups : pool->setBounds[slot].mipBlocks;
-    if (bounds.empty()) return result();
+    if (bounds.empty()) return;
     const vec2 span = rcBoxSpan(o, invDir, vec3(bounds.lo * blockCells - ivec3(blockOrigin)),
                                 vec3(bounds.hi * blockCells - ivec3(blockOrigin)));
     t = max(t, span.x);
@@ -172,11 +165,11 @@ struct TiledRaycastKernel : RaycastPoolAccess {
         axis = exit[0] <= exit[1] ? (exit[0] <= exit[2] ? 0 : 2) : (exit[1] <= exit[2] ? 1 : 2);
         t = rcStepPast(exit[axis]);
         cell[axis] += step[axis];
-        if (t > tEnd || cell[axis] < 0 || cell[axis] >= B) return result();
+        if (t > tEnd || cell[axis] < 0 || cell[axis] >= B) return;
         slabAxis = axis;
         slabSide = step[axis];
       } else {
-        if (t > tEnd) return result();
+        if (t > tEnd) return;
         const ivec3 c = clamp(ivec3(floor(o + t * dir)), ivec3(0), ivec3(B - 1));
         cell[0] = c.x;
         cell[1] = c.y;
@@ -239,12 +232,14 @@ struct TiledRaycastKernel : RaycastPoolAccess {
       }
       const float cellExit = std::min(std::min(exit[0], exit[1]), exit[2]);
       if ((P.foam.x & kFoamVolume) != 0u) {
-        foamInFront = rcAccumulateFoam(foamInFront, slot, o, dir, t, min(cellExit, nearest.t));
-        if (foamInFront >= P.volume.z) return result();  // rcFoamOpaque
+        ray.foam = rcAccumulateFoam(ray.foam, slot, o, dir, t, min(cellExit, nearest.t));
+        if (rcFoamOpaque(ray)) return;
       }
-      if (nearest.t <= cellExit) return rcSphereHit(result(), slot, nearest);
+      if (nearest.t <= cellExit) {
+        rcSphereHit(ray, slot, nearest);
+        return;
+      }
     }
-    return result();
   }
 };
 
@@ -302,8 +297,8 @@ std::vector<std::uint32_t> TiledCpuRaycaster::trace(const RaycastParams& params)
       glsl::TiledRaycastKernel kernel(access, caches.local());
       // A row of at most kTileSize rays is traced into `row`, then copied out whole: the hits'
       // lines miss the cache (44 MB a 1280x720 frame), and a store that misses holds up every
-      // later load that must wait for stores (copies of a RayHit written in parts), so each is
-      // fetched for writing (prefetched) before the row is traced.
+      // later load that must wait for stores, so each is fetched for writing (prefetched)
+      // before the row is traced.
       std::array<RayHit, kTileSize> row;
       for (std::uint32_t y = tile.rows().begin(); y != tile.rows().end(); ++y) {
         for (std::uint32_t x0 = tile.cols().begin(); x0 < tile.cols().end(); x0 += kTileSize) {
@@ -312,8 +307,8 @@ std::vector<std::uint32_t> TiledCpuRaycaster::trace(const RaycastParams& params)
           for (std::size_t byte = 0; byte < columns * sizeof(RayHit); byte += 64)
             __builtin_prefetch(reinterpret_cast<const char*>(out) + byte, 1);
           for (std::uint32_t c = 0; c < columns; ++c) {
-            const RayHit ray = rayAt(std::size_t(y) * mWidth + x0 + c);
-            row[c] = kernel.rcNeedsPass(ray) ? kernel.rcPass(glm::uvec2(x0 + c, y), ray) : ray;
+            row[c] = rayAt(std::size_t(y) * mWidth + x0 + c);
+            if (kernel.rcNeedsPass(row[c])) kernel.rcPass(glm::uvec2(x0 + c, y), row[c]);
           }
           std::copy(row.begin(), row.begin() + columns, out);
         }

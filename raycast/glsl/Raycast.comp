@@ -44,9 +44,9 @@ uint rcLiquidHalfCountOfBits(uint slot, uvec2 h);
 uint rcFoamHalfCountOfBits(uint slot, uvec2 h);
 uint rcLiquidHalfCount(uint slot, uvec2 h) { return rcLiquidHalfCountOfBits(slot, h); }
 uint rcFoamHalfCount(uint slot, uvec2 h) { return rcFoamHalfCountOfBits(slot, h); }
-RayHit rcTraceBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t, float tEnd);
-RayHit rcMarchBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t, float tEnd) {
-  return rcTraceBrick(result, slot, brick, eye, dir, t, tEnd);
+void rcTraceBrick(inout RayHit result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t, float tEnd);
+void rcMarchBrick(inout RayHit result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t, float tEnd) {
+  rcTraceBrick(result, slot, brick, eye, dir, t, tEnd);
 }
 
 #include "Raycast.glsl"
@@ -57,5 +57,6 @@ void main() {
   uint index = pixel.y * P.image.x + pixel.x;
   RayHit ray = hits[index];
   if (!rcNeedsPass(ray)) return;
-  hits[index] = rcPass(pixel, ray);
+  rcPass(pixel, ray);
+  hits[index] = ray;
 }

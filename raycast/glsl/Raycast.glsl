@@ -17,10 +17,13 @@
 //   uint  rcLiquidHalfCount(uint slot, uvec2 h)   sphere cells of half block h (rcHalfBlock) of a
 //   uint  rcFoamHalfCount(uint slot, uvec2 h)     slot, and its foam cells: rcLiquidHalfCountOfBits
 //                                                 and rcFoamHalfCountOfBits, or a table of them
-//   RayHit rcMarchBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t,
-//                       float tEnd)               the march through one resident brick that rcTrace
+//   void rcMarchBrick(FS_INOUT(RayHit) ray, uint slot, uvec3 brick, vec3 eye, vec3 dir,
+//                     float t, float tEnd)        the march through one resident brick that rcTrace
 //                                                 runs: rcTraceBrick, or an equivalent (the fast
 //                                                 CPU device's, raycast/TiledCpuRaycaster.cpp)
+//
+// A ray's RayHit is updated in place (FS_INOUT) from rcPass down to the march: on the CPU, a
+// copy of a struct just written field by field waits for those stores to reach the cache.
 //
 // Model. Every set cell of a bit-brick holds one sphere of radius P.sphere.x cells centred at the
 // cell centre plus the cell's jitter (§3.2.2). A sphere reaches cells at most k = P.brick.y away
@@ -223,20 +226,19 @@ FS_FUNC NearestSphere rcNearerSphere(NearestSphere nearest, ivec3 cell, vec3 cen
   return nearest;
 }
 
-// `result` as a hit on the sphere `nearest` of `slot`. A march ends on it once it lies no
+// Makes `ray` a hit on the sphere `nearest` of `slot`. A march ends on it once it lies no
 // farther than the exit of the cell just tested: a nearer one would have been found in an
 // earlier cell.
-FS_FUNC RayHit rcSphereHit(RayHit result, uint slot, NearestSphere nearest) {
-  result.normal = vec4(normalize(nearest.normal), rcCellAttribute(slot, nearest.cell));
-  result.t = nearest.t;
-  result.status = kRayHit;
-  return result;
+FS_FUNC void rcSphereHit(FS_INOUT(RayHit) ray, uint slot, NearestSphere nearest) {
+  ray.normal = vec4(normalize(nearest.normal), rcCellAttribute(slot, nearest.cell));
+  ray.t = nearest.t;
+  ray.status = kRayHit;
 }
 
-// Traces the segment [t, tEnd] of the ray through resident brick `brick` (at `slot`). Returns a
-// hit in `result` (status kRayHit) or leaves result.status pending; with kFoamVolume it adds the
-// foam in front of the hit (or of tEnd) to result.foam and returns as soon as rcFoamOpaque.
-FS_FUNC RayHit rcTraceBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t, float tEnd) {
+// Traces the segment [t, tEnd] of the ray through resident brick `brick` (at `slot`). Makes
+// `result` a hit (status kRayHit) or leaves its status pending; with kFoamVolume it adds the foam
+// in front of the hit (or of tEnd) to result.foam and returns as soon as rcFoamOpaque.
+FS_FUNC void rcTraceBrick(FS_INOUT(RayHit) result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t, float tEnd) {
   int B = int(P.grid.w);
   int k = int(P.brick.y);
   float jitter = P.sphere.y;
@@ -249,7 +251,7 @@ FS_FUNC RayHit rcTraceBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec
   NearestSphere nearest = rcNoSphere();
   ivec3 previous = ivec3(-1000000);
   for (uint step = 0u; step < kRaycastMaxSteps; step++) {
-    if (t > tEnd) return result;
+    if (t > tEnd) return;
     vec3 p = o + t * dir;
     ivec3 cell = clamp(ivec3(floor(p)), ivec3(0), ivec3(B - 1));
     float clearExit = rcClearBlockExit(slot, cell, o, invDir);
@@ -278,12 +280,14 @@ FS_FUNC RayHit rcTraceBrick(RayHit result, uint slot, uvec3 brick, vec3 eye, vec
     float cellExit = rcBoxSpan(o, invDir, vec3(cell), vec3(cell + ivec3(1))).y;
     if ((P.foam.x & kFoamVolume) != 0u) {
       result.foam = rcAccumulateFoam(result.foam, slot, o, dir, t, min(cellExit, nearest.t));
-      if (rcFoamOpaque(result)) return result;
+      if (rcFoamOpaque(result)) return;
     }
-    if (nearest.t <= cellExit) return rcSphereHit(result, slot, nearest);
+    if (nearest.t <= cellExit) {
+      rcSphereHit(result, slot, nearest);
+      return;
+    }
     t = rcStepPast(cellExit);
   }
-  return result;
 }
 
 // Index of `brick` (brick-grid coordinates inside the grid) in the frame's brick table, or
@@ -348,10 +352,10 @@ FS_FUNC ThicknessTrace rcThickness(vec3 eye, vec3 dir, float tHit) {
   return trace;
 }
 
-// Continues `ray` (pending, from ray.t) for `pixel` until it hits, misses, or stops at a brick
-// that is not resident (then requested). A ray that exhausts kRaycastMaxSteps is a miss.
-FS_FUNC RayHit rcTrace(uvec2 pixel, RayHit ray) {
-  RayHit result = ray;
+// Continues `result` (pending, from result.t) for `pixel` until it hits, misses, or stops at a
+// brick that is not resident (then requested). A ray that exhausts kRaycastMaxSteps is a miss.
+FS_FUNC void rcTrace(uvec2 pixel, FS_INOUT(RayHit) result) {
+  float resume = result.t;
   vec3 eye = vec3(P.eye.x, P.eye.y, P.eye.z);
   vec3 dir = rcCameraRay(pixel);
   vec3 invDir = rcSafeInverse(dir);
@@ -362,11 +366,11 @@ FS_FUNC RayHit rcTrace(uvec2 pixel, RayHit ray) {
   result.brickIndex = kNotResident;
   result.depth = 0.0f;
   result.t = 0.0f;  // a miss carries no distance
-  if (P.pool.z == 0u || domain.x > domain.y || domain.y < 0.0f) return result;
-  float t = max(max(ray.t, domain.x), 0.0f);
+  if (P.pool.z == 0u || domain.x > domain.y || domain.y < 0.0f) return;
+  float t = max(max(resume, domain.x), 0.0f);
   uint levels = P.brick.z;
   for (uint step = 0u; step < kRaycastMaxSteps; step++) {
-    if (t > domain.y) return result;
+    if (t > domain.y) return;
     vec3 p = eye + t * dir;
     // B is a power of two: multiplying by 1 / B is exact, and cheaper than dividing.
     uvec3 brick = uvec3(clamp(ivec3(floor(p * (1.0f / float(B)))), ivec3(0), ivec3(P.grid.x, P.grid.y, P.grid.z) - ivec3(1)));
@@ -402,44 +406,41 @@ FS_FUNC RayHit rcTrace(uvec2 pixel, RayHit ray) {
       result.t = t;
       result.status = kRayPending;
       result.brickIndex = brickIndex;
-      return result;
+      return;
     }
     // 3. March the brick.
     vec3 lo = vec3(brick * uvec3(B));
     float brickExit = rcBoxSpan(eye, invDir, lo, lo + vec3(float(B))).y;
     result.status = kRayPending;
-    result = rcMarchBrick(result, slot, brick, eye, dir, t, brickExit);
+    rcMarchBrick(result, slot, brick, eye, dir, t, brickExit);
     if (rcFoamOpaque(result)) {
       result.status = kRayMiss;
-      return result;
+      return;
     }
     if (result.status == kRayHit) {
       result.brickIndex = brickIndex;
       result.depth = result.t * P.up.w * dot(dir, vec3(P.forward.x, P.forward.y, P.forward.z));
-      return result;
+      return;
     }
     result.status = kRayMiss;
     t = rcStepPast(max(brickExit, t));
   }
-  return result;
 }
 
 // Fills in the thickness of a hit `ray` (status kRayHit) for `pixel`: the bricks behind the hit
 // must be resident; a missing one is requested and the thickness stays -1 (unknown), so the
 // next pass comes back to it. The hit itself is final. P.sphere.w = 0: thickness 0 at once.
-FS_FUNC RayHit rcResolveThickness(uvec2 pixel, RayHit ray) {
-  RayHit result = ray;
-  result.thickness = 0.0f;
-  if (P.sphere.w <= 0.0f) return result;
+FS_FUNC void rcResolveThickness(uvec2 pixel, FS_INOUT(RayHit) ray) {
+  ray.thickness = 0.0f;
+  if (P.sphere.w <= 0.0f) return;
   vec3 eye = vec3(P.eye.x, P.eye.y, P.eye.z);
   ThicknessTrace trace = rcThickness(eye, rcCameraRay(pixel), ray.t);
   if (trace.missingBrick != kNotResident) {
     rcRequest(trace.missingBrick);
-    result.thickness = -1.0f;
+    ray.thickness = -1.0f;
   } else {
-    result.thickness = trace.cells * P.up.w;
+    ray.thickness = trace.cells * P.up.w;
   }
-  return result;
 }
 
 // Whether a pass still has work for `ray`: a pending ray, or a hit whose thickness is unknown.
@@ -448,11 +449,11 @@ FS_FUNC bool rcNeedsPass(RayHit ray) {
 }
 
 // One pass of the ray of `pixel`: continues a pending ray (rcTrace), or resolves a hit's thickness.
-FS_FUNC RayHit rcPass(uvec2 pixel, RayHit ray) {
+FS_FUNC void rcPass(uvec2 pixel, FS_INOUT(RayHit) ray) {
   if (ray.status == kRayPending) {
-    RayHit traced = rcTrace(pixel, ray);
-    if (traced.status == kRayHit) return rcResolveThickness(pixel, traced);
-    return traced;
+    rcTrace(pixel, ray);
+    if (ray.status == kRayHit) rcResolveThickness(pixel, ray);
+    return;
   }
-  return rcResolveThickness(pixel, ray);
+  rcResolveThickness(pixel, ray);
 }
