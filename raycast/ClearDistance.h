@@ -33,4 +33,30 @@ struct SetBlockBounds {
 /// The bounds of the set blocks `setBlocks` (as buildClearDistances) of a grid of `dims`.
 SetBlockBounds setBlockBounds(const std::uint32_t* setBlocks, glm::uvec3 dims);
 
+/// What a march tests around the first cell it meets after crossing a cube of clear blocks.
+struct SlabAfterClearCube {
+  int axis = -1;  ///< -1: the whole neighbourhood; else the slab at cell[axis] + side * k
+  int side = 0;   ///< -1 or 1
+};
+
+/// For `cell` met just after crossing the clear cube [lo, hi) (cells, per axis): no sphere lies
+/// within the reach k of a cell of a clear block (the blocks' dilation is the reach), so when
+/// `cell` lies beside the cube across one face, its neighbourhood but for the far slab is within
+/// k of the cube's cell next to it and holds none: only that slab is tested, as after a DDA
+/// step. Across an edge or a corner of the cube, or farther from it, the whole neighbourhood is.
+inline SlabAfterClearCube slabAfterClearCube(const int cell[3], const int lo[3], const int hi[3]) {
+  SlabAfterClearCube slab;
+  int outside = 0;  // axes on which the cell lies beside the cube, and 2 for one farther away
+  for (int a = 0; a < 3; a++) {
+    const int side = cell[a] < lo[a] ? -1 : cell[a] >= hi[a] ? 1 : 0;
+    if (side == 0) continue;
+    const int gap = side < 0 ? lo[a] - cell[a] : cell[a] - hi[a] + 1;
+    outside += gap == 1 ? 1 : 2;
+    slab.axis = a;
+    slab.side = side;
+  }
+  if (outside != 1) slab = SlabAfterClearCube{};
+  return slab;
+}
+
 }  // namespace flipscope

@@ -189,18 +189,9 @@ struct TiledRaycastKernel : RaycastPoolAccess {
         continue;
       }
       if (leftClearBlock) {
-        // Beside the block across one face: the cells within k of its neighbour inside the
-        // block hold no sphere, so only the far slab remains.
-        int outside = 0;
-        for (int a = 0; a < 3; a++) {
-          const int side = cell[a] < clearLo[a] ? -1 : cell[a] >= clearHi[a] ? 1 : 0;
-          const int gap = side < 0 ? clearLo[a] - cell[a] : side > 0 ? cell[a] - clearHi[a] + 1 : 0;
-          if (side == 0) continue;
-          outside += gap == 1 ? 1 : 2;
-          slabAxis = a;
-          slabSide = side;
-        }
-        if (outside != 1) slabAxis = -1;
+        const SlabAfterClearCube slab = slabAfterClearCube(cell, clearLo, clearHi);
+        slabAxis = slab.axis;
+        slabSide = slab.side;
         leftClearBlock = false;
       }
       const vec3 p = o + t * dir;

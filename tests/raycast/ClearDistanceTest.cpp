@@ -1,5 +1,6 @@
 // ClearDistance against brute force: each block's Chebyshev distance, in blocks, to the nearest
-// set block (0 when set), capped at kMaxClearDistance; and the bounds of the set blocks.
+// set block (0 when set), capped at kMaxClearDistance; the bounds of the set blocks; and the
+// slab a march tests after crossing a clear cube.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -87,6 +88,37 @@ TEST(ClearDistance, SetBlockBoundsHoldEverySetBlockAndNoMore) {
       EXPECT_EQ(bounds.lo, lo);
       EXPECT_EQ(bounds.hi, hi);
     }
+}
+
+TEST(ClearDistance, AfterAClearCubeOnlyAFaceNeighbourTestsJustItsFarSlab) {
+  const int lo[3] = {4, 8, 0}, hi[3] = {12, 16, 8};
+  auto slab = [&](int x, int y, int z) {
+    const int cell[3] = {x, y, z};
+    return slabAfterClearCube(cell, lo, hi);
+  };
+  // Beside each of the six faces: that axis, towards the cell.
+  EXPECT_EQ(slab(12, 10, 3).axis, 0);
+  EXPECT_EQ(slab(12, 10, 3).side, 1);
+  EXPECT_EQ(slab(3, 10, 3).axis, 0);
+  EXPECT_EQ(slab(3, 10, 3).side, -1);
+  EXPECT_EQ(slab(5, 16, 3).axis, 1);
+  EXPECT_EQ(slab(5, 16, 3).side, 1);
+  EXPECT_EQ(slab(5, 7, 3).axis, 1);
+  EXPECT_EQ(slab(5, 7, 3).side, -1);
+  EXPECT_EQ(slab(11, 15, 8).axis, 2);
+  EXPECT_EQ(slab(11, 15, 8).side, 1);
+  EXPECT_EQ(slab(4, 8, -1).axis, 2);
+  EXPECT_EQ(slab(4, 8, -1).side, -1);
+  // Across an edge, a corner, or two cells away: the whole neighbourhood.
+  EXPECT_EQ(slab(12, 16, 3).axis, -1);
+  EXPECT_EQ(slab(3, 7, 3).axis, -1);
+  EXPECT_EQ(slab(12, 10, 8).axis, -1);
+  EXPECT_EQ(slab(12, 16, 8).axis, -1);
+  EXPECT_EQ(slab(3, 7, -1).axis, -1);
+  EXPECT_EQ(slab(13, 10, 3).axis, -1);
+  EXPECT_EQ(slab(5, 10, -2).axis, -1);
+  // Inside the cube (a march never meets one there): the whole neighbourhood.
+  EXPECT_EQ(slab(5, 10, 3).axis, -1);
 }
 
 }  // namespace
