@@ -16,13 +16,13 @@
 #include <cstddef>
 #include <optional>
 
+#include "smoothing/detail/CpuRofIterations.h"
 #include "smoothing/detail/CpuScreenKernel.h"
 #include "smoothing/detail/Filters.h"
 
 namespace flipscope {
 
 namespace glsl {
-#include "smoothing/glsl/RofTypes.glsl"
 static_assert(sizeof(RofParams) == 16 && offsetof(RofParams, adaptive) == 12);
 
 struct RofKernel : CpuScreenKernel {
@@ -58,6 +58,12 @@ class RofFilter : public SurfaceFilter {
     params.tau = 0.25f;
     params.adaptive = mOptions.strength > 0 ? 1u : 0u;
     device.run(kExtrude, params, {depth}, *mDomain);
+    if (auto* cpu = dynamic_cast<CpuScreenDevice*>(&device)) {
+      // The same iterations over compact images (detail/CpuRofIterations.h): the same result.
+      iterateRofOnCpu(*cpu, params, mOptions.iterations, *mDomain, mDiv[0]);
+      device.run(kResult, params, {depth, mDiv[0]}, output);
+      return;
+    }
     device.run(kStart, params, {*mDomain}, mDiv[0]);
     device.clear(mDual[0]);  // p^(0) = 0
     int current = 0;
