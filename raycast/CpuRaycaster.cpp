@@ -92,17 +92,25 @@ void CpuRaycaster::classifyFoam(std::span<const std::uint32_t> slots, const Foam
   const PoolLayout& layout = mPool.layout;
   FLIPSCOPE_CHECK(layout.foam && params.brick.z == layout.subBricksPerSlot &&
                   params.brick.w == slots.size() * layout.subBricksPerSlot);
+  // In place, as on the GPU: a sub-brick's classification reads no foam bits but its own.
+  timedClassify(slots, params, [&](std::uint32_t slot) {
+    glsl::FoamKernel kernel{params, &mPool};
+    glm::uvec4* foam = &mPool.foamBits[std::size_t(slot) * layout.subBricksPerSlot];
+    for (std::uint32_t s = 0; s < layout.subBricksPerSlot; ++s) foam[s] = kernel.fcClassify(slot, s);
+  });
+}
+
+void CpuRaycaster::timedClassify(std::span<const std::uint32_t> slots, const FoamClassifyParams& params,
+                                 const std::function<void(std::uint32_t slot)>& classify) {
+  const PoolLayout& layout = mPool.layout;
   const auto start = std::chrono::steady_clock::now();
-  const glsl::FoamKernel kernel{params, &mPool};
-  // In place, as on the GPU: a sub-brick's classification reads no foam bits but its own; the
-  // occupancy of a brick reads its foam once every sub-brick of it is classified.
   tbb::parallel_for(std::size_t(0), slots.size(), [&](std::size_t i) {
     FLIPSCOPE_CHECK(slots[i] < layout.slots);
-    glsl::FoamKernel local = kernel;
-    glm::uvec4* foam = &mPool.foamBits[std::size_t(slots[i]) * layout.subBricksPerSlot];
-    for (std::uint32_t s = 0; s < layout.subBricksPerSlot; ++s) foam[s] = local.fcClassify(slots[i], s);
+    classify(slots[i]);
+    // The occupancy of a brick reads its foam once every sub-brick of it is classified.
+    glsl::FoamKernel kernel{params, &mPool};
     std::uint32_t* occupancy = &mPool.foamOccupancy[std::size_t(slots[i]) * layout.foamOccupancyWords()];
-    for (std::uint32_t w = 0; w < layout.foamOccupancyWords(); ++w) occupancy[w] = local.fcOccupancyWord(slots[i], w);
+    for (std::uint32_t w = 0; w < layout.foamOccupancyWords(); ++w) occupancy[w] = kernel.fcOccupancyWord(slots[i], w);
   });
   mLastClassifyMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }

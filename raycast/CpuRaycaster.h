@@ -66,6 +66,11 @@ class CpuRaycaster : public RaycastDevice {
   const Pool& pool() const { return mPool; }
 
  protected:
+  /// classifyFoam's frame: for each slot, in parallel, `classify` writes its foam bits (in place,
+  /// as fcClassify gives them), then its foam occupancy (fcOccupancyWord); records
+  /// lastClassifyMs.
+  void timedClassify(std::span<const std::uint32_t> slots, const FoamClassifyParams& params,
+                     const std::function<void(std::uint32_t slot)>& classify);
   /// One pass of trace(): `pass` continues the pending rays of mHits through the pool that
   /// `access` reads, whose rcRequest flags the bricks they stop at. Returns those bricks
   /// ascending and records lastTraceMs.

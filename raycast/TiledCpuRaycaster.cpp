@@ -10,6 +10,7 @@
 #include "core/Error.h"
 #include "raycast/ClearDistance.h"
 #include "raycast/CpuRaycastKernel.h"
+#include "raycast/FoamNeighbourCount.h"
 #include "raycast/NearSphereMask.h"
 
 namespace flipscope {
@@ -276,7 +277,11 @@ void TiledCpuRaycaster::uploadBrick(std::uint32_t slot, std::uint64_t attributeO
 }
 
 void TiledCpuRaycaster::classifyFoam(std::span<const std::uint32_t> slots, const FoamClassifyParams& params) {
-  CpuRaycaster::classifyFoam(slots, params);
+  tbb::enumerable_thread_specific<FoamNeighbourScratch> scratch;
+  timedClassify(slots, params, [&](std::uint32_t slot) {
+    const std::size_t first = std::size_t(slot) * mPool.layout.subBricksPerSlot;
+    classifyBrickFoam(&mPool.subBricks[first], &mPool.foamBits[first], params, scratch.local());
+  });
   tbb::parallel_for(std::size_t(0), slots.size(), [&](std::size_t i) { buildMarchTables(slots[i]); });
 }
 

@@ -29,6 +29,8 @@
 //    cell met on leaving a cube through a face tests only its far slab, since no sphere lies
 //    within the reach of the cube. A brick's march starts and ends at the box of the set
 //    blocks (SetBlockBounds): a ray that passes over the liquid in a brick tests nothing.
+//  - the foam classification (§3.5) counts a cell's neighbours in a byte grid of the brick and
+//    stops once it has enough not to be foam (FoamNeighbourCount): the reference's bits.
 // The rest of the pass (octree descent, requests, foam, attributes, thickness) is
 // Raycast.glsl itself, compiled once more around the new brick march (rcMarchBrick).
 #pragma once

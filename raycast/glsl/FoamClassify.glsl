@@ -52,10 +52,12 @@ FS_FUNC uvec4 fcClassify(uint slot, uint subBrick) {
   for (uint bit = 0u; bit < 128u; bit++) {
     if (!bitBrickBitSet(bits, bit)) continue;
     ivec3 s = origin + ivec3(int(bit & 3u), int((bit >> 2u) & 3u), int(bit >> 4u));
+    // Counting stops once the cell has the neighbours it needs not to be foam: in a liquid
+    // body, after a few of them.
     uint count = 0u;
-    for (int dz = -reach; dz <= reach; dz++)
-      for (int dy = -reach; dy <= reach; dy++)
-        for (int dx = -reach; dx <= reach; dx++) {
+    for (int dz = -reach; dz <= reach && float(count) < needed; dz++)
+      for (int dy = -reach; dy <= reach && float(count) < needed; dy++)
+        for (int dx = -reach; dx <= reach && float(count) < needed; dx++) {
           if (float(dx * dx + dy * dy + dz * dz) > radius * radius || (dx == 0 && dy == 0 && dz == 0)) continue;
           if (fcStoredCellSet(slot, s + ivec3(dx, dy, dz))) count++;
         }
