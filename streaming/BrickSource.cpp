@@ -6,6 +6,8 @@
 
 #include <glm/common.hpp>
 #include <glm/vector_relational.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
 
 #include "core/Error.h"
 
@@ -50,19 +52,31 @@ Box occupiedBounds(BrickSource& source, int first, int last) {
   }
   const glm::dvec3 lower(lo * h.brickSize), upper((hi + 1u) * h.brickSize);
   if (outer.size() > kMaxDecoded) return Box{h.origin + lower * h.cellSize, h.origin + upper * h.cellSize};
-  glm::dvec3 cellMin(std::numeric_limits<double>::infinity()), cellMax(-std::numeric_limits<double>::infinity());
-  for (const auto& [index, i] : outer) {
-    const auto brick = source.read(BrickKey{index->frame, index->bricks[i].coord});
-    FLIPSCOPE_CHECK(brick, "brick " << i << " of frame " << index->frame << " listed but empty");
-    const glm::dvec3 base(index->bricks[i].coord * h.brickSize);
-    for (std::uint32_t cell : brick->cells) {
-      const glm::dvec3 c =
-          base + glm::dvec3(cell % h.brickSize, cell / h.brickSize % h.brickSize, cell / (h.brickSize * h.brickSize));
-      cellMin = glm::min(cellMin, c);
-      cellMax = glm::max(cellMax, c + 1.0);
-    }
-  }
-  return Box{h.origin + cellMin * h.cellSize, h.origin + cellMax * h.cellSize};
+  // The bricks are decoded over every core (BrickSource is thread safe).
+  using CellBounds = std::pair<glm::dvec3, glm::dvec3>;
+  const CellBounds none{glm::dvec3(std::numeric_limits<double>::infinity()),
+                        glm::dvec3(-std::numeric_limits<double>::infinity())};
+  const CellBounds cells = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, outer.size(), 4), none,
+      [&](const tbb::blocked_range<std::size_t>& range, CellBounds bounds) {
+        for (std::size_t o = range.begin(); o != range.end(); ++o) {
+          const auto& [index, i] = outer[o];
+          const auto brick = source.read(BrickKey{index->frame, index->bricks[i].coord});
+          FLIPSCOPE_CHECK(brick, "brick " << i << " of frame " << index->frame << " listed but empty");
+          const glm::dvec3 base(index->bricks[i].coord * h.brickSize);
+          for (std::uint32_t cell : brick->cells) {
+            const glm::dvec3 c = base + glm::dvec3(cell % h.brickSize, cell / h.brickSize % h.brickSize,
+                                                   cell / (h.brickSize * h.brickSize));
+            bounds.first = glm::min(bounds.first, c);
+            bounds.second = glm::max(bounds.second, c + 1.0);
+          }
+        }
+        return bounds;
+      },
+      [](const CellBounds& a, const CellBounds& b) {
+        return CellBounds{glm::min(a.first, b.first), glm::max(a.second, b.second)};
+      });
+  return Box{h.origin + cells.first * h.cellSize, h.origin + cells.second * h.cellSize};
 }
 
 }  // namespace flipscope
