@@ -80,6 +80,7 @@ struct FramePipeline::Stages {
   std::unique_ptr<SurfaceShading> shading;
   bool thickness = false;         ///< the ray-caster traces the thickness (liquid shading)
   bool litSpheres = false;        ///< spheres shading: the image's normals are the spheres'
+  bool shadedReadOut = false;     ///< CPU: `shaded`'s pixels moved to the output since shade()
   /// The smoothed depth: the G-buffer itself when the filter keeps the depth (not run).
   ScreenImage smoothedDepth() const { return filter->keepsDepth() ? gbuffer : smoothed; }
 };
@@ -254,6 +255,7 @@ void FramePipeline::shade(int frame, const Camera& camera, StageTimes& stages) {
       header.attribute != AttributeKind::None ? mRenderer->source().frame(frame)->stats : FrameStats{};
   s.shading->setFrameAttributeRange(stats.attributeMin, stats.attributeMax);
   timed(stages.shading, [&] { s.shading->shade(device, s.gbuffer, s.normals, s.sphereNormals, s.shaded); });
+  s.shadedReadOut = false;
 }
 
 const FrameOutput& FramePipeline::readOutput() {
@@ -269,15 +271,12 @@ const FrameOutput& FramePipeline::readOutput() {
   RenderImage& image = out.image;
   image.width = device.width();
   image.height = device.height();
-  // The CPU device's images are read in place; the GPU's are downloaded.
+  // The CPU device's images are read in place, its shaded pixels moved into the output (once a
+  // shading: the next one writes the image the output gave back); the GPU's are downloaded.
   auto* cpu = dynamic_cast<CpuScreenDevice*>(&device);
   if (cpu) {
-    const auto shaded = cpu->pixels(s.shaded);
-    image.rgba.resize(shaded.size());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, shaded.size(), 1 << 16),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        std::copy(shaded.begin() + r.begin(), shaded.begin() + r.end(), image.rgba.begin() + r.begin());
-                      });
+    if (!s.shadedReadOut) cpu->exchangePixels(s.shaded, image.rgba);
+    s.shadedReadOut = true;
   } else {
     image.rgba = device.download(s.shaded);
   }

@@ -55,6 +55,13 @@ std::span<const glm::vec4> CpuScreenDevice::read(ScreenImage handle) {
 
 std::span<glm::vec4> CpuScreenDevice::pixels(ScreenImage handle) { return target(handle).data; }
 
+void CpuScreenDevice::exchangePixels(ScreenImage handle, std::vector<glm::vec4>& pixels) {
+  Image& image = target(handle);
+  FLIPSCOPE_CHECK(image.perPixel > 0, "screen image " << handle << " is not a frame image");
+  pixels.resize(image.data.size());
+  image.data.swap(pixels);
+}
+
 void CpuScreenDevice::upload(ScreenImage handle, std::span<const glm::vec4> data) {
   Image& image = target(handle);
   FLIPSCOPE_CHECK(data.size() == image.data.size(), data.size() << " != " << image.data.size());

@@ -28,6 +28,9 @@ class CpuScreenDevice : public ScreenDevice {
 
   /// The image's elements in place (no copy), for callers on the CPU; not of an adopted image.
   std::span<glm::vec4> pixels(ScreenImage image);
+  /// Moves the frame image's pixels into `pixels` (no copy) and takes the vector's storage, sized
+  /// to the image, in their place: its contents are undefined until a pass writes the image.
+  void exchangePixels(ScreenImage image, std::vector<glm::vec4>& pixels);
   /// An image that passes read where `pixels` says it is, at each run (the CPU ray-caster's
   /// hits, `perPixel` vec4 a pixel): nothing is copied. It is an input only.
   ScreenImage adoptFramePixels(std::function<std::span<const glm::vec4>()> pixels, std::uint32_t perPixel);

@@ -76,6 +76,30 @@ TEST(FramePipeline, SmoothingChangesTheDepthButNotTheMask) {
   EXPECT_GT(changed, 1e-3);
 }
 
+TEST(FramePipeline, TheOutputReadsTheSameAgainAndAfterTheNextFrame) {
+  // On the CPU the shaded pixels move into the output (no copy): reading it again, rendering
+  // again and rendering progressively must all give the same image.
+  testing::TempDir dir("pipeline");
+  const testing::BallScene ball;
+  FramePipeline pipeline(ball.makeStore(dir.path() / "store"), DeviceChoice::Cpu, ball.settings(), SurfaceSettings{});
+  const std::vector<glm::vec4> first = pipeline.render(0, ball.camera()).image.rgba;
+  ASSERT_FALSE(first.empty());
+  EXPECT_GT(std::count_if(first.begin(), first.end(), [](const glm::vec4& c) { return c.a == 1.0f && c.r > 0; }), 1000);
+  EXPECT_EQ(pipeline.readOutput().image.rgba, first);
+  EXPECT_EQ(pipeline.readOutput().image.rgba, first);
+  Camera farther = ball.camera();
+  farther.eye = farther.target + (farther.eye - farther.target) * 1.5;
+  const std::vector<glm::vec4> second = pipeline.render(0, farther).image.rgba;
+  EXPECT_NE(second, first);
+  EXPECT_EQ(pipeline.readOutput().image.rgba, second);
+  EXPECT_EQ(pipeline.render(0, ball.camera()).image.rgba, first);
+  pipeline.begin(0, ball.camera());
+  for (int i = 0; i < 100 && !pipeline.finished(); ++i) pipeline.advance(1000.0);
+  ASSERT_TRUE(pipeline.finished());
+  EXPECT_EQ(pipeline.readOutput().image.rgba, first);
+  EXPECT_EQ(pipeline.readOutput().image.rgba, first);
+}
+
 TEST(FramePipeline, ShadingModesGiveDifferentLooks) {
   const FrameOutput liquid = renderBall("rof", ShadingMode::Liquid);
   const FrameOutput spheres = renderBall("rof", ShadingMode::Spheres);
