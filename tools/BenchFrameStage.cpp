@@ -31,6 +31,7 @@ struct FrameStageArgs {
 double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 void runStage(const FrameStageArgs& a) {
+  keepHeapForReuse();  // core/ProcessMemory.h
   const auto [width, height] = parseImageSize("--size", a.request.size);
   const auto start = Clock::now();
   BrickStore store = BrickStore::open(a.store);

@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/Error.h"
+#include "core/ProcessMemory.h"
 #include "pipeline/FramePipeline.h"
 #include "pipeline/RenderRequest.h"
 #include "preprocess/SynthFluid.h"
@@ -109,6 +110,7 @@ ViewRates measure(const fs::path& storeDir, bool gpu, const BenchViewArgs& a) {
 }
 
 void runBenchView(const BenchViewArgs& a) {
+  keepHeapForReuse();  // core/ProcessMemory.h
   if (a.frames < 2) throw InputError("--frames: at least 2");
   const fs::path work = a.workDir.empty() ? fs::temp_directory_path() / "flipscope-bench-view" : fs::path(a.workDir);
   fs::create_directories(work);

@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "core/Error.h"
+#include "core/ProcessMemory.h"
 #include "core/Progress.h"
 #include "raycast/ImageWriter.h"
 
@@ -26,6 +27,7 @@ std::string outputPathForFrame(const std::string& pattern, int frame) {
 }
 
 std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
+  keepHeapForReuse();  // core/ProcessMemory.h
   BrickStore store = BrickStore::open(job.store);
   const std::vector<int> stored = store.frames();
   if (stored.empty())

@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "core/Error.h"
+#include "core/ProcessMemory.h"
 #include "gl/EglContext.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
@@ -32,6 +33,7 @@ struct ViewArgs {
 };
 
 void runView(const ViewArgs& a) {
+  keepHeapForReuse();  // core/ProcessMemory.h
   viewer::ViewerOptions o;
   o.inputs = a.inputs;
   o.cacheDir = a.cache;

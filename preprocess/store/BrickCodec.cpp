@@ -132,7 +132,16 @@ DecodedBrick decodeBrick(std::span<const std::byte> payload, const std::filesyst
     throw fail("payload is not a zstd frame of known size");
   if (declared > bound) throw fail("payload declares " + std::to_string(declared) + " bytes, more than possible");
   ZSTD_DCtx* context = threadDecompressor();
-  std::vector<std::byte> raw;
+  // The thread's buffer, kept from brick to brick: a fresh one per brick cost a first touch of
+  // its pages each time (most of the page faults of a large first image).
+  // One larger than a one-shot read is let go after this brick.
+  thread_local std::vector<std::byte> raw;
+  struct ReleaseLarge {
+    std::vector<std::byte>& buffer;
+    ~ReleaseLarge() {
+      if (buffer.capacity() > kOneShotBytes) std::vector<std::byte>().swap(buffer);
+    }
+  } release{raw};
   if (declared <= std::max<std::uint64_t>(kOneShotBytes, 64 * std::uint64_t(payload.size()))) {
     raw.resize(declared);
     const std::size_t n = ZSTD_decompressDCtx(context, raw.data(), raw.size(), payload.data(), payload.size());
