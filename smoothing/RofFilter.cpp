@@ -45,10 +45,16 @@ class RofFilter : public SurfaceFilter {
   explicit RofFilter(const SmoothingOptions& options) : mOptions(options) {}
 
   void apply(ScreenDevice& device, ScreenImage depth, ScreenImage output) override {
+    // The CPU device iterates over compact images of its own (detail/CpuRofIterations.h), with
+    // the same result; it needs no dual images, nor a second div.
+    auto* cpu = dynamic_cast<CpuScreenDevice*>(&device);
     if (!mDomain) {
       mDomain = device.createFrameImage();
-      for (ScreenImage& image : mDual) image = device.createFrameImage();
-      for (ScreenImage& image : mDiv) image = device.createFrameImage();
+      mDiv[0] = device.createFrameImage();
+      if (!cpu) {
+        for (ScreenImage& image : mDual) image = device.createFrameImage();
+        mDiv[1] = device.createFrameImage();
+      }
     }
     const ScreenFrame& frame = device.frame();
     const float r = frame.particleRadius;
@@ -58,9 +64,8 @@ class RofFilter : public SurfaceFilter {
     params.tau = 0.25f;
     params.adaptive = mOptions.strength > 0 ? 1u : 0u;
     device.run(kExtrude, params, {depth}, *mDomain);
-    if (auto* cpu = dynamic_cast<CpuScreenDevice*>(&device)) {
-      // The same iterations over compact images (detail/CpuRofIterations.h): the same result.
-      iterateRofOnCpu(*cpu, params, mOptions.iterations, *mDomain, mDiv[0]);
+    if (cpu) {
+      mCpuIterations.run(*cpu, params, mOptions.iterations, *mDomain, mDiv[0]);
       device.run(kResult, params, {depth, mDiv[0]}, output);
       return;
     }
@@ -78,6 +83,7 @@ class RofFilter : public SurfaceFilter {
  private:
   SmoothingOptions mOptions;
   std::optional<ScreenImage> mDomain;
+  CpuRofIterations mCpuIterations;
   ScreenImage mDual[2] = {}, mDiv[2] = {};
 };
 }  // namespace

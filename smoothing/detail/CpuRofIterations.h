@@ -6,6 +6,12 @@
 // stay 0, as the kernels return there. Each iteration then moves a third of the bytes.
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec2.hpp>
+
 #include "smoothing/CpuScreenDevice.h"
 
 namespace flipscope::glsl {
@@ -14,10 +20,23 @@ namespace flipscope::glsl {
 
 namespace flipscope::detail {
 
-/// Runs `iterations` ROF iterations from p = 0 and the domain's lambda^(0) (rofStart), on
-/// `domain` (rofExtrude's image); writes div p and lambda of the last one to `div` as
-/// rofDivergence writes them (div p^(0) and lambda^(0) when `iterations` is 0).
-void iterateRofOnCpu(CpuScreenDevice& device, const glsl::RofParams& params, int iterations, ScreenImage domain,
-                     ScreenImage div);
+/// The compact images, kept from frame to frame (a filter owns one).
+class CpuRofIterations {
+ public:
+  /// Runs `iterations` ROF iterations from p = 0 and the domain's lambda^(0) (rofStart), on
+  /// `domain` (rofExtrude's image); writes div p and lambda of the last one to `div` as
+  /// rofDivergence writes them (div p^(0) and lambda^(0) when `iterations` is 0).
+  void run(CpuScreenDevice& device, const glsl::RofParams& params, int iterations, ScreenImage domain,
+           ScreenImage div);
+
+ private:
+  /// A run of domain pixels [begin, end) of one row.
+  struct Run {
+    std::uint32_t begin, end;
+  };
+  std::vector<glm::vec2> mDomain, mDual[2], mDivergence[2];  ///< (depth, mask); p; (div p, lambda)
+  std::vector<Run> mRuns;
+  std::vector<std::size_t> mRowRuns;  ///< row y's runs: mRuns[mRowRuns[y], mRowRuns[y + 1])
+};
 
 }  // namespace flipscope::detail
