@@ -1,7 +1,7 @@
 // The ROF filter's iterations on the CPU device (smoothing/detail/CpuRofIterations.h, compact
 // images, one sweep an iteration) give the result of its passes run one by one on the same
 // device, bit for bit: the passes are run here through a ScreenDevice that forwards to a
-// CpuScreenDevice but is not one, so RofFilter takes its general path.
+// CpuScreenDevice but is not one, so RofFilter takes its general path; and from frame to frame.
 #include <gtest/gtest.h>
 
 #include <vector>
@@ -72,6 +72,26 @@ TEST(CpuRofIterations, EqualThePassesRunOneByOne) {
         EXPECT_GT(changed, int(fast.size() / 20));
       }
     }
+  }
+}
+
+TEST(CpuRofIterations, OneFilterKeepsNothingFromItsLastFrame) {
+  // The filter keeps its compact images from frame to frame: a frame of another size and another
+  // domain, then the first again, must each give what a fresh filter gives.
+  const testing::DepthScene scenes[] = {testing::sphereScene(97, 61, 0.5f, 3.0f, 0.8f, 4.0f, 3),
+                                        testing::sphereScene(64, 37, 0.8f, 2.5f, 0.6f, 0.0f, 5),
+                                        testing::sphereScene(97, 61, 0.5f, 3.0f, 0.8f, 4.0f, 3)};
+  const SmoothingOptions options{.name = "rof", .iterations = 17, .strength = 3.0f};
+  CpuScreenDevice cpu;
+  const auto filter = createSurfaceFilter(options);
+  for (const testing::DepthScene& scene : scenes) {
+    SCOPED_TRACE(::testing::Message() << scene.frame.size.x << "x" << scene.frame.size.y);
+    cpu.setFrame(scene.frame);
+    const ScreenImage depth = cpu.createFrameImage(), output = cpu.createFrameImage();
+    cpu.upload(depth, scene.depth);
+    filter->apply(cpu, depth, output);
+    ForwardingScreenDevice passes;
+    EXPECT_EQ(cpu.download(output), smooth(passes, scene, options));
   }
 }
 
