@@ -1,13 +1,13 @@
 // UninitializedVector<T>: a std::vector whose resize() leaves new trivial elements
 // uninitialized, for large buffers that are overwritten right away (sort keys, scratch):
-// no memset, and pages are touched only once, by the writer. Buffers of 2 MiB and more are
-// 2 MiB aligned and advised as transparent huge pages: on virtual machines page faults are
-// costly, and binning 100 M particles touches gigabytes of fresh memory.
+// no memset, and pages are touched only once, by the writer.
+//
+// No transparent huge pages: on the virtual machines we measured (the development machine,
+// 2026-12-03, `madvise` THP), the first touch of 400 MB advised MADV_HUGEPAGE took 0.3 to 3.1 s
+// and of 400 MB of plain pages 0.13 s, every time: a 2 MiB page comes from the blocks the guest
+// has handed back to its host, which must back all of it again.
 #pragma once
 
-#include <sys/mman.h>
-
-#include <cstdlib>
 #include <memory>
 #include <new>
 #include <type_traits>
@@ -17,7 +17,6 @@ namespace flipscope {
 
 template <class T>
 struct DefaultInitAllocator : std::allocator<T> {
-  static constexpr std::size_t kHugePage = std::size_t(2) << 20;
   static_assert(std::is_trivially_default_constructible_v<T>);
   template <class U>
   struct rebind {
@@ -26,18 +25,6 @@ struct DefaultInitAllocator : std::allocator<T> {
   DefaultInitAllocator() = default;
   template <class U>
   DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
-  T* allocate(std::size_t n) {
-    const std::size_t bytes = n * sizeof(T);
-    if (bytes < kHugePage) return std::allocator<T>::allocate(n);
-    void* p = std::aligned_alloc(kHugePage, (bytes + kHugePage - 1) / kHugePage * kHugePage);
-    if (!p) throw std::bad_alloc();
-    ::madvise(p, bytes, MADV_HUGEPAGE);  // advice only: ignored where THP is off
-    return static_cast<T*>(p);
-  }
-  void deallocate(T* p, std::size_t n) noexcept {
-    if (n * sizeof(T) < kHugePage) return std::allocator<T>::deallocate(p, n);
-    std::free(p);
-  }
   template <class U>
   void construct(U* p) noexcept {
     ::new (static_cast<void*>(p)) U;

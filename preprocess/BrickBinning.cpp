@@ -1,16 +1,18 @@
 // Binning of particle keys into encoded bricks (layout in BrickBinning.h).
-// Sorting: an MSD counting sort on the brick Morton code in 16-bit digits (one parallel pass
-// for the grids of practice, whose codes have at most 18 bits), then per brick either a cell
-// histogram (dense bricks) or a comparison sort (sparse bricks).
+// Sorting: an in-place MSD radix sort on the brick Morton code in 16-bit digits (American flag
+// sort: one pass for the grids of practice, whose codes have at most 15 bits), then per brick
+// either a cell histogram (dense bricks) or a comparison sort (sparse bricks). In place, because
+// fresh memory is what binning pays most for: on the virtual machines of farms and clouds the
+// first touch of a page costs more than the sort's moves.
 #include "preprocess/BrickBinning.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include <glm/geometric.hpp>
@@ -28,7 +30,8 @@ KeyGrid::KeyGrid(const StoreHeader& h, std::optional<Box> clipBox)
       cells(glm::u64vec3(h.brickGrid) * std::uint64_t(h.brickSize)),
       brickShift(std::uint32_t(std::countr_zero(h.brickSize))),
       cellBits(3 * brickShift),
-      codeBits(3 * octreeLevelsFor(std::max({h.brickGrid.x, h.brickGrid.y, h.brickGrid.z}))) {
+      codeBits(3 * octreeLevelsFor(std::max({h.brickGrid.x, h.brickGrid.y, h.brickGrid.z}))),
+      valueInKey(h.attribute != AttributeKind::None && cellBits + codeBits <= kPackedCellBits) {
   FLIPSCOPE_CHECK(cellBits + codeBits + 16 <= 64, "grid too large for 64-bit keys");
 }
 
@@ -56,11 +59,10 @@ ParticleKind kindOfTypeValue(float flags) {
   return fromMantaflowType(std::int32_t(flags));
 }
 
-KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, AttributeKind kind, KeyBatch& out,
-                     const AttributeColumn* types) {
+KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& out, const AttributeColumn* types) {
   const std::size_t n = chunk.size();
+  const AttributeKind kind = grid.header.attribute;
   FLIPSCOPE_CHECK(!types || (types->arity == 1 && types->values.size() == n), "a type column needs one value a particle");
-  const bool attribute = kind != AttributeKind::None;
   FLIPSCOPE_CHECK(kind != AttributeKind::Speed || chunk.velocities.size() == n, "speed needs velocities");
   FLIPSCOPE_CHECK(kind != AttributeKind::Scalar || (!chunk.attributes.empty() && chunk.attributes.front().arity == 1 &&
                                                     chunk.attributes.front().values.size() == n),
@@ -69,80 +71,81 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, AttributeK
                       (!chunk.attributes.empty() &&
                        chunk.attributes.front().values.size() == n * std::size_t(chunk.attributes.front().arity)),
                   "a vector attribute needs its column");
-  constexpr std::uint64_t kInvalid = ~0ull, kOutside = ~0ull - 1;
+  const bool attribute = grid.attribute();
+  const bool separateValues = attribute && !grid.valueInKey;
   const std::size_t base = out.cellKeys.size();
   out.cellKeys.resize(base + n);
-  if (attribute) out.values.resize(base + n);
+  if (separateValues) out.values.resize(base + n);
   std::uint64_t* keys = out.cellKeys.data() + base;
-  float* values = attribute ? out.values.data() + base : nullptr;
+  float* values = separateValues ? out.values.data() + base : nullptr;
   const std::uint32_t mask = grid.header.brickSize - 1;
 
+  // Fixed blocks, each compacted in place by its own task; skipped particles close up after.
   struct Tally {
+    std::size_t kept = 0;
     std::uint64_t invalid = 0, outside = 0;
     float valueMin = std::numeric_limits<float>::infinity(), valueMax = -std::numeric_limits<float>::infinity();
   };
-  const Tally tally = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, n, 1 << 14), Tally{},
-      [&](const auto& range, Tally t) {
-        for (std::size_t i = range.begin(); i != range.end(); ++i) {
-          const glm::vec3 p = chunk.positions[i];
-          if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-            keys[i] = kInvalid;
-            ++t.invalid;
-            continue;
-          }
-          const glm::dvec3 q(p);
-          const glm::dvec3 c = fastFloor((q - grid.header.origin) * grid.invCellSize);
-          if ((grid.clip && !grid.clip->contains(q)) || c.x < 0 || c.y < 0 || c.z < 0 ||
-              c.x >= double(grid.cells.x) || c.y >= double(grid.cells.y) || c.z >= double(grid.cells.z)) {
-            keys[i] = kOutside;
-            ++t.outside;
-            continue;
-          }
-          const glm::uvec3 cell(c);
-          const glm::uvec3 brick = cell >> grid.brickShift;
-          const glm::uvec3 local = cell & mask;
-          const std::uint64_t code = mortonEncode3(brick.x, brick.y, brick.z);
-          const std::uint64_t inBrick = local.x | (local.y << grid.brickShift) | (local.z << (2 * grid.brickShift));
-          keys[i] = (code << grid.cellBits) | inBrick;
-          if (types) keys[i] |= std::uint64_t(kindOfTypeValue(types->values[i])) << kKindShift;
-          if (values) {
-            const float s = attributeValue(chunk, kind, i);
-            values[i] = s;
-            if (std::isfinite(s)) {
-              t.valueMin = std::min(t.valueMin, s);
-              t.valueMax = std::max(t.valueMax, s);
-            }
-          }
-        }
-        return t;
-      },
-      [](Tally a, const Tally& b) {
-        a.invalid += b.invalid;
-        a.outside += b.outside;
-        a.valueMin = std::min(a.valueMin, b.valueMin);
-        a.valueMax = std::max(a.valueMax, b.valueMax);
-        return a;
-      });
+  constexpr std::size_t kBlock = 1 << 14;
+  std::vector<Tally> tallies((n + kBlock - 1) / kBlock);
+  tbb::parallel_for(std::size_t(0), tallies.size(), [&](std::size_t b) {
+    Tally& t = tallies[b];
+    const std::size_t begin = b * kBlock, end = std::min(n, begin + kBlock);
+    for (std::size_t i = begin; i != end; ++i) {
+      const glm::vec3 p = chunk.positions[i];
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+        ++t.invalid;
+        continue;
+      }
+      const glm::dvec3 q(p);
+      const glm::dvec3 c = fastFloor((q - grid.header.origin) * grid.invCellSize);
+      if ((grid.clip && !grid.clip->contains(q)) || c.x < 0 || c.y < 0 || c.z < 0 ||
+          c.x >= double(grid.cells.x) || c.y >= double(grid.cells.y) || c.z >= double(grid.cells.z)) {
+        ++t.outside;
+        continue;
+      }
+      const glm::uvec3 cell(c);
+      const glm::uvec3 brick = cell >> grid.brickShift;
+      const glm::uvec3 local = cell & mask;
+      const std::uint64_t code = mortonEncode3(brick.x, brick.y, brick.z);
+      const std::uint64_t inBrick = local.x | (local.y << grid.brickShift) | (local.z << (2 * grid.brickShift));
+      const std::uint64_t cellKey = (code << grid.cellBits) | inBrick;
+      const std::uint64_t particleKind = types ? std::uint64_t(kindOfTypeValue(types->values[i])) : 0;
+      const float s = attribute ? attributeValue(chunk, kind, i) : 0.0f;
+      if (attribute && std::isfinite(s)) {
+        t.valueMin = std::min(t.valueMin, s);
+        t.valueMax = std::max(t.valueMax, s);
+      }
+      const std::size_t to = begin + t.kept++;
+      if (grid.valueInKey) {
+        keys[to] = (((particleKind << kPackedCellBits) | cellKey) << 32) | std::bit_cast<std::uint32_t>(s);
+      } else {
+        keys[to] = (particleKind << kKindShift) | cellKey;
+        if (values) values[to] = s;
+      }
+    }
+  });
 
-  const std::size_t skipped = tally.invalid + tally.outside;
-  KeyTally result{n - skipped, tally.invalid, tally.outside};
-  if (attribute && tally.valueMin <= tally.valueMax) {
-    result.ranged = true;
-    result.valueMin = tally.valueMin;
-    result.valueMax = tally.valueMax;
-  }
-  if (skipped == 0) return result;
-  // Rare: compact in order (keeps the stream deterministic).
+  KeyTally result;
   std::size_t kept = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (keys[i] == kInvalid || keys[i] == kOutside) continue;
-    keys[kept] = keys[i];
-    if (values) values[kept] = values[i];
-    ++kept;
+  for (std::size_t b = 0; b < tallies.size(); ++b) {
+    const Tally& t = tallies[b];
+    if (kept != b * kBlock && t.kept) {  // rare: close up after skipped particles, in order
+      std::memmove(keys + kept, keys + b * kBlock, t.kept * sizeof(*keys));
+      if (values) std::memmove(values + kept, values + b * kBlock, t.kept * sizeof(*values));
+    }
+    kept += t.kept;
+    result.invalid += t.invalid;
+    result.outside += t.outside;
+    if (attribute && t.valueMin <= t.valueMax) {
+      result.valueMin = result.ranged ? std::min(result.valueMin, t.valueMin) : t.valueMin;
+      result.valueMax = result.ranged ? std::max(result.valueMax, t.valueMax) : t.valueMax;
+      result.ranged = true;
+    }
   }
+  result.kept = kept;
   out.cellKeys.resize(base + kept);
-  if (attribute) out.values.resize(base + kept);
+  if (values) out.values.resize(base + kept);
   return result;
 }
 
@@ -154,70 +157,92 @@ std::uint16_t quantizeAttribute(float s, float min, float max) {
   return std::uint16_t(std::lround(t * 65535.0f));
 }
 
+void makeBinningKeys(KeyBatch& batch, const KeyGrid& grid, float min, float max) {
+  const bool attribute = grid.attribute(), kinds = grid.header.particleKinds;
+  std::uint64_t* keys = batch.cellKeys.data();
+  const float* values = batch.values.data();
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, batch.cellKeys.size(), 1 << 16), [&](const auto& range) {
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      std::uint64_t cellKey = keys[i];
+      float value = 0.0f;
+      if (grid.valueInKey) {
+        const auto high = std::uint32_t(keys[i] >> 32);
+        cellKey = (high & ((1u << kPackedCellBits) - 1)) | (std::uint64_t(high >> kPackedCellBits) << kKindShift);
+        value = std::bit_cast<float>(std::uint32_t(keys[i]));
+      } else if (attribute) {
+        value = values[i];
+      }
+      keys[i] = binningKey(cellKey, attribute ? quantizeAttribute(value, min, max) : 0, kinds);
+    }
+  });
+  ValueVector().swap(batch.values);
+}
+
 namespace {
 
 constexpr std::uint32_t kDigitBits = 16;
 constexpr std::size_t kParallelThreshold = 1 << 16;
 
-/// Stable counting sort of keys[begin,end) by the digit (key >> shift) & (2^bits - 1) into
-/// out[begin,end); returns the start offset of each digit value (size 2^bits + 1).
-std::vector<std::size_t> countingSort(const std::uint64_t* in, std::uint64_t* out, std::size_t n, std::uint32_t shift,
-                                      std::uint32_t bits) {
+struct BrickRun {
+  std::size_t begin, end;
+};
+
+/// Sorts keys[begin,end) in place by the bits [lowBit, highBit) (the brick code), most
+/// significant digit first (American flag sort: a histogram, then each key swapped into its
+/// digit's range); appends one run per distinct code in ascending code order.
+void splitByBrick(std::uint64_t* keys, std::size_t begin, std::size_t end, std::uint32_t lowBit,
+                  std::uint32_t highBit, std::vector<BrickRun>& runs) {
+  if (begin == end) return;
+  if (highBit <= lowBit) {
+    runs.push_back({begin, end});
+    return;
+  }
+  const std::uint32_t bits = std::min(kDigitBits, highBit - lowBit);
+  const std::uint32_t shift = highBit - bits;
+  const std::uint64_t mask = (1ull << bits) - 1;
+  auto digit = [&](std::uint64_t key) { return std::size_t((key >> shift) & mask); };
+  std::uint64_t* const a = keys + begin;
+  const std::size_t n = end - begin;
+  // Fast path: every key has the same digit.
+  const std::size_t first = digit(a[0]);
+  bool uniform = true;
+  for (std::size_t i = 1; i < n && uniform; ++i) uniform = digit(a[i]) == first;
+  if (uniform) return splitByBrick(keys, begin, end, lowBit, shift, runs);
+
   const std::size_t buckets = std::size_t(1) << bits;
-  const std::uint64_t mask = buckets - 1;
   const std::size_t blocks = n >= kParallelThreshold ? 8 : 1;
   const std::size_t blockSize = (n + blocks - 1) / blocks;
   std::vector<std::vector<std::size_t>> histograms(blocks, std::vector<std::size_t>(buckets, 0));
   tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
     auto& h = histograms[b];
     const std::size_t e = std::min(n, (b + 1) * blockSize);
-    for (std::size_t i = b * blockSize; i < e; ++i) ++h[(in[i] >> shift) & mask];
+    for (std::size_t i = b * blockSize; i < e; ++i) ++h[digit(a[i])];
   });
-  std::vector<std::size_t> starts(buckets + 1, 0);
-  std::size_t offset = 0;
+  std::vector<std::size_t> heads(buckets + 1, 0);  // heads[d]: next slot of digit d; ends: heads[d + 1] at start
   for (std::size_t d = 0; d < buckets; ++d) {
-    starts[d] = offset;
-    for (std::size_t b = 0; b < blocks; ++b) {
-      const std::size_t count = histograms[b][d];
-      histograms[b][d] = offset;
-      offset += count;
+    heads[d + 1] = heads[d];
+    for (const auto& h : histograms) heads[d + 1] += h[d];
+  }
+  const std::vector<std::size_t> starts = heads;
+  for (std::size_t d = 0; d < buckets; ++d) {
+    const std::size_t stop = starts[d + 1];
+    while (heads[d] < stop) {
+      std::uint64_t key = a[heads[d]];
+      for (std::size_t e = digit(key); e != d; e = digit(key)) std::swap(key, a[heads[e]++]);
+      a[heads[d]++] = key;
     }
   }
-  starts[buckets] = offset;
-  tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
-    auto& h = histograms[b];
-    const std::size_t e = std::min(n, (b + 1) * blockSize);
-    for (std::size_t i = b * blockSize; i < e; ++i) out[h[(in[i] >> shift) & mask]++] = in[i];
-  });
-  return starts;
-}
-
-struct BrickRun {
-  std::size_t begin, end;  // in the array that holds the run after sorting
-  bool inScratch;
-};
-
-/// MSD counting sort by brick code; appends one run per brick in ascending code order.
-void splitByBrick(std::uint64_t* keys, std::uint64_t* scratch, std::size_t begin, std::size_t end,
-                  std::uint32_t lowBit, std::uint32_t highBit, bool inScratch, std::vector<BrickRun>& runs) {
-  if (begin == end) return;
-  if (highBit <= lowBit) {
-    runs.push_back({begin, end, inScratch});
+  if (shift == lowBit) {
+    for (std::size_t d = 0; d < buckets; ++d)
+      if (starts[d] != starts[d + 1]) runs.push_back({begin + starts[d], begin + starts[d + 1]});
     return;
   }
-  const std::uint64_t* src = (inScratch ? scratch : keys) + begin;
-  std::uint64_t* dst = (inScratch ? keys : scratch) + begin;
-  const std::uint32_t bits = std::min(kDigitBits, highBit - lowBit);
-  const std::uint32_t shift = highBit - bits;
-  // Fast path: every key has the same digit.
-  const std::uint64_t first = (src[0] >> shift) & ((1ull << bits) - 1);
-  bool uniform = true;
-  for (std::size_t i = 1; i < end - begin && uniform; ++i) uniform = ((src[i] >> shift) & ((1ull << bits) - 1)) == first;
-  if (uniform) return splitByBrick(keys, scratch, begin, end, lowBit, shift, inScratch, runs);
-  auto starts = countingSort(src, dst, end - begin, shift, bits);
-  for (std::size_t d = 0; d + 1 < starts.size(); ++d)
-    if (starts[d] != starts[d + 1])
-      splitByBrick(keys, scratch, begin + starts[d], begin + starts[d + 1], lowBit, shift, !inScratch, runs);
+  // Deeper digits: the digit's ranges are sorted independently, their runs kept in order.
+  std::vector<std::vector<BrickRun>> sub(buckets);
+  tbb::parallel_for(std::size_t(0), buckets, [&](std::size_t d) {
+    splitByBrick(keys, begin + starts[d], begin + starts[d + 1], lowBit, shift, sub[d]);
+  });
+  for (const auto& r : sub) runs.insert(runs.end(), r.begin(), r.end());
 }
 
 /// Encodes one brick's keys (same brick code, any order) into `out` (reuses its vectors); with
@@ -282,13 +307,13 @@ void decodeRun(std::span<std::uint64_t> keys, const KeyGrid& grid, bool attribut
 
 }  // namespace
 
-void binKeys(KeyVector& keys, KeyVector& scratch, const KeyGrid& grid, bool attribute, bool kinds,
-             int zstdLevel, const std::function<void(EncodedBrick&&)>& sink) {
+void binKeys(std::span<std::uint64_t> keys, const KeyGrid& grid, int zstdLevel,
+             const std::function<void(EncodedBrick&&)>& sink) {
   if (keys.empty()) return;
-  scratch.resize(keys.size());
+  const bool attribute = grid.attribute(), kinds = grid.header.particleKinds;
   std::vector<BrickRun> runs;
   const std::uint32_t lowBit = 16 + grid.cellBits;
-  splitByBrick(keys.data(), scratch.data(), 0, keys.size(), lowBit, lowBit + grid.codeBits, false, runs);
+  splitByBrick(keys.data(), 0, keys.size(), lowBit, lowBit + grid.codeBits, runs);
 
   constexpr std::size_t kBatch = 64;
   std::vector<EncodedBrick> batch;
@@ -297,7 +322,7 @@ void binKeys(KeyVector& keys, KeyVector& scratch, const KeyGrid& grid, bool attr
     batch.assign(count, {});
     tbb::parallel_for(std::size_t(0), count, [&](std::size_t i) {
       const BrickRun& run = runs[first + i];
-      std::span<std::uint64_t> span((run.inScratch ? scratch : keys).data() + run.begin, run.end - run.begin);
+      const std::span<std::uint64_t> span = keys.subspan(run.begin, run.end - run.begin);
       thread_local DecodedBrick brick;
       thread_local std::vector<std::uint32_t> histogram;
       thread_local std::vector<ParticleKind> cellKinds;

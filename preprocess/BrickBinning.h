@@ -4,12 +4,12 @@
 // Key layout (fits because a store has at most 65536 = 2^16 cells per axis):
 //   [ brick Morton code : 3*(16 - log2 B) bits ][ cell in brick : 3*log2 B bits ][ attribute : 16 bits ]
 // so sorting keys orders particles by brick (Morton), then cell (x fastest), then attribute:
-// the canonical order of a brick payload. Keys are built without the attribute first
-// (`cellKey`, 48 bits) because the attribute's quantization range is known only after the
-// whole frame was read.
+// the canonical order of a brick payload. Keys are built as batch keys first (KeyBatch: the
+// `cellKey`, 48 bits, and the attribute's value) because the attribute's quantization range is
+// known only after the whole frame was read.
 //
-// Stores with particle kinds: the cell key carries the particle's kind in bits 48-49 (through
-// the counting sort by brick and the spill files, which look at the brick code only), and the
+// Stores with particle kinds: the cell key carries the particle's kind (through the spill files,
+// which look at the brick code only), and the
 // full key is [ brick ][ cell ][ attribute : 14 bits ][ kind : 2 bits ] (binningKey). Of the
 // layouts that fit 64 bits this is the simplest and fastest: nothing travels beside the keys,
 // attributes stay ascending within a cell (DecodedBrick), and a cell's kind, the smallest of its
@@ -43,17 +43,31 @@ struct KeyGrid {
   std::uint32_t brickShift; ///< log2(brickSize)
   std::uint32_t cellBits;   ///< 3 * brickShift
   std::uint32_t codeBits;   ///< 3 * octree levels: bits of a brick Morton code
+  /// Whether a batch key carries its particle's attribute value (see KeyBatch): the store has an
+  /// attribute and a cell key fits kPackedCellBits.
+  bool valueInKey;
 
+  bool attribute() const { return header.attribute != AttributeKind::None; }
+  /// Where a batch key's cell key starts: 32 when valueInKey, else 0.
+  std::uint32_t cellKeyShift() const { return valueInKey ? 32 : 0; }
 };
 
 /// Bits of a cell key below the kind (ParticleKind in bits 48-49 of stores with kinds).
 inline constexpr std::uint32_t kKindShift = 48;
 inline constexpr std::uint64_t kCellKeyMask = (1ull << kKindShift) - 1;
+/// Bits of a cell key below the kind in a batch key that carries its value (KeyGrid::valueInKey).
+inline constexpr std::uint32_t kPackedCellBits = 30;
 
 using KeyVector = UninitializedVector<std::uint64_t>;
 using ValueVector = UninitializedVector<float>;
 
-/// Keys of particles: cellKeys (48-bit) and, when the store has an attribute, its values.
+/// Keys of particles, one batch key a particle, in one of two layouts (KeyGrid::valueInKey):
+/// - [ kind : 2 ][ cell key : 30 ][ attribute value : float32 bits ], values empty; the usual
+///   layout of stores with an attribute, 8 bytes a particle;
+/// - [ kind : 2 at bit 48 ][ cell key : 48 ], and values[i] the attribute value when the store
+///   has one (grids whose cell keys need more than 30 bits).
+/// The attribute's quantization range is known only after the whole frame was read, so the
+/// value travels with the key until makeBinningKeys().
 struct KeyBatch {
   KeyVector cellKeys;
   ValueVector values;
@@ -81,11 +95,11 @@ float attributeValue(const ParticleChunk& chunk, AttributeKind kind, std::size_t
 /// type flags (fromMantaflowType); a value that is no int32 is liquid.
 ParticleKind kindOfTypeValue(float flags);
 
-/// Appends the keys of `chunk` to `out` (parallel over the chunk, deterministic order), and the
-/// values of attribute `kind` (attributeValue; not None) when it is not None. With `types` (a
+/// Appends the batch keys of `chunk` to `out` (parallel over the chunk, deterministic order),
+/// with the values of the store's attribute (attributeValue) when it has one. With `types` (a
 /// column of chunk, arity 1: the particles' type flags), each key carries the particle's kind
-/// (kindOfTypeValue) in bits 48-49; without, none (liquid).
-KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, AttributeKind kind, KeyBatch& out,
+/// (kindOfTypeValue); without, none (liquid).
+KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& out,
                      const AttributeColumn* types = nullptr);
 
 /// Quantizes value s into [0, 65535] over [min, max] (NaN and -inf: 0, +inf: 65535).
@@ -99,6 +113,10 @@ inline std::uint64_t binningKey(std::uint64_t cellKey, std::uint16_t attribute, 
   return ((cellKey & kCellKeyMask) << 16) | (narrow << 2) | (cellKey >> kKindShift);
 }
 
+/// Turns the batch keys of `batch` into binning keys in place (binningKey, with the attribute
+/// quantized over [min, max]) and frees its values.
+void makeBinningKeys(KeyBatch& batch, const KeyGrid& grid, float min, float max);
+
 /// One encoded brick, ready for FrameWriter::addBrick.
 struct EncodedBrick {
   glm::uvec3 coord;
@@ -108,10 +126,10 @@ struct EncodedBrick {
   std::vector<std::byte> payload;
 };
 
-/// Sorts `keys` (full 64-bit keys, binningKey) by brick, groups them and encodes each brick, with
-/// a kind per cell when `kinds`; calls `sink` in ascending Morton order. `scratch` is resized to
-/// keys.size(). Memory: keys + scratch + one batch of compressed payloads.
-void binKeys(KeyVector& keys, KeyVector& scratch, const KeyGrid& grid, bool attribute, bool kinds,
-             int zstdLevel, const std::function<void(EncodedBrick&&)>& sink);
+/// Sorts `keys` (binning keys) by brick in place, groups them and encodes each brick, with a
+/// kind per cell when the store has kinds; calls `sink` in ascending Morton order. Memory: keys +
+/// one batch of compressed payloads.
+void binKeys(std::span<std::uint64_t> keys, const KeyGrid& grid, int zstdLevel,
+             const std::function<void(EncodedBrick&&)>& sink);
 
 }  // namespace flipscope::detail

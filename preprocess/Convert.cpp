@@ -64,8 +64,8 @@ void stopPoint(const char* point) {
 
 /// Memory plan of one conversion, all derived from the budget.
 struct MemoryPlan {
-  explicit MemoryPlan(std::uint64_t budget, bool attribute) {
-    const std::uint64_t perParticle = attribute ? 20 : 16;  // key + scratch (+ value)
+  explicit MemoryPlan(std::uint64_t budget, bool separateValues) {
+    const std::uint64_t perParticle = separateValues ? 12 : 8;  // key (+ value): binning sorts in place
     chunkParticles = std::clamp<std::uint64_t>(budget / 256 / 24, 4096, 1 << 20);
     maxBinParticles = std::max<std::uint64_t>(budget * 6 / 10 / perParticle, 1 << 16);
     maxBucketFiles = std::clamp<std::uint64_t>(budget / 8 / kSpillBufferBytes, 2, 256);
@@ -75,16 +75,17 @@ struct MemoryPlan {
   std::uint64_t maxBucketFiles;   ///< spill files open at once
 };
 
-/// Spill record: 48-bit cell key, then the attribute value when the store has an attribute.
-std::size_t recordBytes(bool attribute) { return attribute ? 12 : 8; }
+/// Spill record: the batch key (KeyBatch), then the attribute value when it travels beside it.
+std::size_t recordBytes(bool values) { return values ? 12 : 8; }
 
-/// Bucket files of one partition level: bucket b holds the keys whose digit
-/// (cellKey >> shift) & (count - 1) is b. Files are removed on destruction.
+/// Bucket files of one partition level: bucket b holds the batch keys whose digit
+/// (key >> shift) & (count - 1) is b, with their values when `values`. Files are removed on
+/// destruction.
 class SpillBuckets {
  public:
   SpillBuckets(const std::filesystem::path& dir, const std::string& prefix, std::uint32_t shift, std::uint32_t bits,
-               bool attribute)
-      : mShift(shift), mBits(bits), mAttribute(attribute) {
+               bool values)
+      : mShift(shift), mBits(bits), mValues(values) {
     const std::size_t count = std::size_t(1) << bits;
     for (std::size_t b = 0; b < count; ++b) {
       Bucket bucket;
@@ -109,7 +110,7 @@ class SpillBuckets {
       Bucket& b = mBuckets[(keys[i] >> mShift) & mask];
       auto* p = reinterpret_cast<const std::byte*>(&keys[i]);
       b.buffer.insert(b.buffer.end(), p, p + 8);
-      if (mAttribute) {
+      if (mValues) {
         auto* s = reinterpret_cast<const std::byte*>(&values[i]);
         b.buffer.insert(b.buffer.end(), s, s + 4);
       }
@@ -140,10 +141,10 @@ class SpillBuckets {
     std::FILE* f = std::fopen(bucket.path.c_str(), "rb");
     if (!f) throw FileError(bucket.path, "cannot reopen spill file");
     constexpr std::size_t kPiece = 8192;
-    const std::size_t bytes = recordBytes(mAttribute);
+    const std::size_t bytes = recordBytes(mValues);
     std::vector<std::byte> buffer(bytes * kPiece);
     std::vector<std::uint64_t> keys(kPiece);
-    std::vector<float> values(mAttribute ? kPiece : 0);
+    std::vector<float> values(mValues ? kPiece : 0);
     for (std::uint64_t done = 0; done < bucket.records;) {
       const std::size_t n = std::min<std::uint64_t>(kPiece, bucket.records - done);
       if (std::fread(buffer.data(), bytes, n, f) != n) {
@@ -152,22 +153,20 @@ class SpillBuckets {
       }
       for (std::size_t i = 0; i < n; ++i) {
         std::memcpy(&keys[i], buffer.data() + i * bytes, 8);
-        if (mAttribute) std::memcpy(&values[i], buffer.data() + i * bytes + 8, 4);
+        if (mValues) std::memcpy(&values[i], buffer.data() + i * bytes + 8, 4);
       }
-      fn(keys.data(), mAttribute ? values.data() : nullptr, n);
+      fn(keys.data(), mValues ? values.data() : nullptr, n);
       done += n;
     }
     std::fclose(f);
   }
 
-  /// Loads bucket b (after finish()) into keys/values.
-  void load(std::size_t b, detail::KeyVector& keys, detail::ValueVector& values) const {
-    keys.clear();
-    values.clear();
-    keys.reserve(mBuckets[b].records);
+  /// Loads bucket b (after finish()) into `batch`.
+  void load(std::size_t b, KeyBatch& batch) const {
+    batch.clear();
     forEachPiece(b, [&](const std::uint64_t* k, const float* s, std::size_t n) {
-      keys.insert(keys.end(), k, k + n);
-      if (s) values.insert(values.end(), s, s + n);
+      batch.cellKeys.insert(batch.cellKeys.end(), k, k + n);
+      if (s) batch.values.insert(batch.values.end(), s, s + n);
     });
   }
 
@@ -194,19 +193,17 @@ class SpillBuckets {
   }
 
   std::uint32_t mShift, mBits;
-  bool mAttribute;
+  bool mValues;
   std::vector<Bucket> mBuckets;
 };
 
 /// Bins one frame's keys: in memory while they fit, spilled to buckets beyond.
 class FrameBinner {
  public:
-  FrameBinner(const KeyGrid& grid, AttributeKind kind, const MemoryPlan& plan, const ConvertOptions& options,
+  FrameBinner(const KeyGrid& grid, const MemoryPlan& plan, const ConvertOptions& options,
               std::filesystem::path scratchDir, int frame)
       : mGrid(grid),
-        mKind(kind),
-        mAttribute(kind != AttributeKind::None),
-        mKinds(grid.header.particleKinds),
+        mValues(grid.attribute() && !grid.valueInKey),
         mPlan(plan),
         mOptions(options),
         mScratch(std::move(scratchDir)),
@@ -214,25 +211,25 @@ class FrameBinner {
 
   /// With particle kinds, the chunk's last column holds the type flags (convertFrame).
   void add(const ParticleChunk& chunk) {
-    const AttributeColumn* types = mKinds ? &chunk.attributes.back() : nullptr;
+    const AttributeColumn* types = mGrid.header.particleKinds ? &chunk.attributes.back() : nullptr;
     if (mSpill) {
       mBatch.clear();
-      account(detail::computeKeys(chunk, mGrid, mKind, mBatch, types));
+      account(detail::computeKeys(chunk, mGrid, mBatch, types));
       mSpill->add(mBatch.cellKeys.data(), mBatch.values.data(), mBatch.cellKeys.size());
       return;
     }
     if (mKeys.cellKeys.capacity() == 0) {  // reserve address space once: no reallocation copies
       mKeys.cellKeys.reserve(mPlan.maxBinParticles + mPlan.chunkParticles);
-      if (mAttribute) mKeys.values.reserve(mPlan.maxBinParticles + mPlan.chunkParticles);
+      if (mValues) mKeys.values.reserve(mPlan.maxBinParticles + mPlan.chunkParticles);
     }
-    account(detail::computeKeys(chunk, mGrid, mKind, mKeys, types));
+    account(detail::computeKeys(chunk, mGrid, mKeys, types));
     if (mKeys.cellKeys.size() > mPlan.maxBinParticles) startSpilling();
   }
 
   /// Bins everything added into `writer`; returns the frame's stats.
   FrameStats finish(FrameWriter& writer) {
     if (!mSpill) {
-      binInMemory(mKeys.cellKeys, mKeys.values, writer);
+      binInMemory(mKeys, writer);
     } else {
       mSpill->finish();
       binBuckets(*mSpill, writer);
@@ -257,32 +254,32 @@ class FrameBinner {
     return std::min(bits, availableBits);
   }
 
+  /// Moves the keys binned so far into bucket files. mKeys keeps its memory: the buckets are
+  /// loaded into it, and pages touched once are not paid for again.
   void startSpilling() {
     const std::uint32_t bits = bucketBitsFor(mGrid.codeBits);
-    mSpill = std::make_unique<SpillBuckets>(mScratch, mPrefix, mGrid.cellBits + mGrid.codeBits - bits, bits, mAttribute);
+    const std::uint32_t shift = mGrid.cellKeyShift() + mGrid.cellBits + mGrid.codeBits - bits;
+    mSpill = std::make_unique<SpillBuckets>(mScratch, mPrefix, shift, bits, mValues);
     mSpill->add(mKeys.cellKeys.data(), mKeys.values.data(), mKeys.cellKeys.size());
-    KeyBatch().cellKeys.swap(mKeys.cellKeys);
-    KeyBatch().values.swap(mKeys.values);
+    mKeys.clear();
     mSpillBuckets += std::uint32_t(mSpill->size());
   }
 
   void binBuckets(const SpillBuckets& buckets, FrameWriter& writer) {
-    detail::KeyVector keys;
-    detail::ValueVector values;
     for (std::size_t b = 0; b < buckets.size(); ++b) {
       if (buckets.records(b) == 0) continue;
       if (buckets.records(b) <= mPlan.maxBinParticles) {
-        buckets.load(b, keys, values);
-        binInMemory(keys, values, writer);
+        buckets.load(b, mKeys);
+        binInMemory(mKeys, writer);
         continue;
       }
       // Skewed data: split this bucket by the next bits of the brick code.
-      const std::uint32_t remaining = buckets.shift() - mGrid.cellBits;
+      const std::uint32_t remaining = buckets.shift() - mGrid.cellKeyShift() - mGrid.cellBits;
       if (remaining == 0)
         throw InputError("a single brick holds " + std::to_string(buckets.records(b)) +
                          " particles, more than --mem allows binning at once; raise --mem or use a smaller cell size");
       const std::uint32_t bits = bucketBitsFor(remaining);
-      SpillBuckets sub(mScratch, mPrefix + "-" + std::to_string(mSpillBuckets), buckets.shift() - bits, bits, mAttribute);
+      SpillBuckets sub(mScratch, mPrefix + "-" + std::to_string(mSpillBuckets), buckets.shift() - bits, bits, mValues);
       mSpillBuckets += std::uint32_t(sub.size());
       buckets.forEachPiece(b, [&](const std::uint64_t* k, const float* s, std::size_t n) { sub.add(k, s, n); });
       sub.finish();
@@ -290,34 +287,27 @@ class FrameBinner {
     }
   }
 
-  void binInMemory(detail::KeyVector& keys, detail::ValueVector& values, FrameWriter& writer) {
-    const float lo = mStats.attributeMin, hi = mStats.attributeMax;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, keys.size(), 1 << 16), [&](const auto& range) {
-      for (std::size_t i = range.begin(); i != range.end(); ++i)
-        keys[i] = detail::binningKey(keys[i], mAttribute ? detail::quantizeAttribute(values[i], lo, hi) : 0, mKinds);
-    });
-    detail::ValueVector().swap(values);
-    detail::KeyVector scratch;
-    detail::binKeys(keys, scratch, mGrid, mAttribute, mKinds, mOptions.zstdLevel, [&](detail::EncodedBrick&& brick) {
+  /// Bins `batch` into `writer`; its keys become binning keys (the batch is empty after).
+  void binInMemory(KeyBatch& batch, FrameWriter& writer) {
+    detail::makeBinningKeys(batch, mGrid, mStats.attributeMin, mStats.attributeMax);
+    detail::binKeys(batch.cellKeys, mGrid, mOptions.zstdLevel, [&](detail::EncodedBrick&& brick) {
       writer.addBrick(brick.coord, brick.particles, brick.cells, brick.payload);
       mStats.particles += brick.particles;
       for (std::size_t k = 0; k < kParticleKindCount; ++k) mStats.kindCells[k] += brick.kindCells[k];
       stopPoint("brick");
     });
-    detail::KeyVector().swap(keys);
+    batch.clear();
   }
 
   const KeyGrid& mGrid;
-  AttributeKind mKind;
-  bool mAttribute;
-  bool mKinds;
+  bool mValues;  ///< attribute values travel beside the keys (not KeyGrid::valueInKey)
   MemoryPlan mPlan;
   const ConvertOptions& mOptions;
   std::filesystem::path mScratch;
   std::string mPrefix;
   FrameStats mStats;
   bool mHasRange = false;
-  KeyBatch mKeys;   // in memory, until spilling starts
+  KeyBatch mKeys;   // in memory until spilling starts; then each bucket in turn
   KeyBatch mBatch;  // one chunk, once spilling
   std::unique_ptr<SpillBuckets> mSpill;
   std::uint32_t mSpillBuckets = 0;
@@ -775,10 +765,10 @@ FrameReport convertOneFrame(ParticleSource& source, BrickStore& store, int frame
   if (kind == AttributeKind::Speed && !source.hasVelocity())
     throw FileError(source.name(), "has no velocities, but the store keeps a speed attribute");
   const KeyGrid grid(header, options.domain);
-  const MemoryPlan plan(options.memoryBudget, attribute);
+  const MemoryPlan plan(options.memoryBudget, attribute && !grid.valueInKey);
   const std::filesystem::path scratch = options.scratchDir.empty() ? store.directory() : options.scratchDir;
 
-  FrameBinner binner(grid, kind, plan, options, scratch, frame);
+  FrameBinner binner(grid, plan, options, scratch, frame);
   ParticleChunk chunk;
   std::optional<PrefetchingSource> ahead;  // the next chunk is read while this one is binned
   ParticleSource& input = readingAhead(source, options.readAhead, ahead);

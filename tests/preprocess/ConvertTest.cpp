@@ -134,6 +134,8 @@ TEST_P(ConvertOracle, StoreMatchesBruteForceBinning) {
   }
 }
 
+// With an attribute, 64 and 0.02 (600 cells) make 30-bit cell keys, which carry their values
+// (KeyGrid::valueInKey), and 128 and 0.01 (1200 cells) 33-bit ones, which do not.
 INSTANTIATE_TEST_SUITE_P(BrickSizes, ConvertOracle,
                          ::testing::Values(Case{32, 0.05, false}, Case{64, 0.02, true}, Case{128, 0.01, true},
                                            Case{32, 0.5, true}));
@@ -150,16 +152,29 @@ TEST(Convert, AttributeQuantizationByHand) {
   EXPECT_EQ(detail::quantizeAttribute(5.0f, 5.0f, 5.0f), 0);      // an empty range
 }
 
-TEST(Convert, OutOfCoreStoreIsByteIdenticalToInCoreWithAndWithoutReadAhead) {
+/// Brick size and cell size of a store over [0, 50)^3, and whether its batch keys carry their
+/// attribute values (KeyBatch's two layouts, also in the spill files).
+struct OutOfCoreCase {
+  std::uint32_t brickSize;
+  double cellSize;
+  bool valueInKey;
+};
+
+class ConvertOutOfCore : public ::testing::TestWithParam<OutOfCoreCase> {};
+
+TEST_P(ConvertOutOfCore, StoreIsByteIdenticalToInCoreWithAndWithoutReadAhead) {
   // ~1.5 M particles (18 MB of float32, 30 MB with velocities) against a 4 MiB budget. Neither
   // budget's chunk (174762 and 4096 particles) divides the count.
+  const OutOfCoreCase c = GetParam();
   auto positions = testing::randomParticles(1500000, 77, 50.0f);
   std::vector<glm::vec3> velocities(positions.size());
   for (std::size_t i = 0; i < positions.size(); ++i) velocities[i] = glm::vec3(std::sin(float(i)), 0.5f, 0);
   ConvertOptions options;
-  options.cellSize = 0.05;
+  options.cellSize = c.cellSize;
+  options.brickSize = c.brickSize;
   options.progress = Progress::Mode::Silent;
   const Box domain{{0, 0, 0}, {50, 50, 50}};
+  ASSERT_EQ(detail::KeyGrid(makeStoreHeader(domain, options, AttributeKind::Speed)).valueInKey, c.valueInKey);
   testing::TempDir temp("out-of-core");
   auto run = [&](std::uint64_t budget, const std::string& name, bool readAhead = true) {
     options.memoryBudget = budget;
@@ -191,6 +206,12 @@ TEST(Convert, OutOfCoreStoreIsByteIdenticalToInCoreWithAndWithoutReadAhead) {
                 e.path().filename() == "frame_000001.fsf")
         << e.path();
 }
+
+// 1000 cells of 64: 30 bits of cell key, the value rides in the key; 2500 cells of 128: 36 bits,
+// the value travels beside it.
+INSTANTIATE_TEST_SUITE_P(KeyLayouts, ConvertOutOfCore,
+                         ::testing::Values(OutOfCoreCase{64, 0.05, true}, OutOfCoreCase{128, 0.02, false}),
+                         [](const auto& info) { return info.param.valueInKey ? "ValueInKey" : "ValueBesideKey"; });
 
 TEST(Convert, SkewedDataSplitsBucketsRecursively) {
   // Most particles in one corner brick region: the first-level bucket overflows.

@@ -101,11 +101,11 @@ std::string join(const std::vector<std::string>& names) {
 }
 
 /// Three frames: 1 and 3 small (2.5 k particles, 1 is where the spacing is measured), 2 with
-/// 70 k particles, which under --mem 1M is binned out of core (spill files).
+/// 120 k particles, which under --mem 1M is binned out of core (spill files).
 class ConvertInterrupt : public ::testing::Test {
  protected:
   void SetUp() override {
-    for (auto [frame, count] : {std::pair{1, "2500"}, std::pair{2, "70k"}, std::pair{3, "2500"}}) {
+    for (auto [frame, count] : {std::pair{1, "2500"}, std::pair{2, "120k"}, std::pair{3, "2500"}}) {
       CommandRun synth = run("synth -o " + (dir / "in_####.bin").string() + " --particles " + count + " --frames " +
                              std::to_string(frame) + " --seed " + std::to_string(frame));
       ASSERT_EQ(synth.exitCode, 0) << synth.output;
@@ -358,7 +358,7 @@ TEST_F(StoreIntegrityCli, AStoreWithoutFramesIsIncomplete) {
 }
 
 TEST_F(StoreIntegrityCli, AFailedConvertLeavesNoStore) {
-  CommandRun big = run("synth -o " + path("big.bin") + " --particles 100k");
+  CommandRun big = run("synth -o " + path("big.bin") + " --particles 200k");
   ASSERT_EQ(big.exitCode, 0) << big.output;
   CommandRun failed = run("convert " + path("big.bin") + " -o " + path("s") + " --mem 1M --scratch " + path("none/x"));
   EXPECT_EQ(failed.exitCode, 3) << failed.output;
