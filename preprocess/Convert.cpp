@@ -21,6 +21,7 @@
 #include "core/AtomicFile.h"
 #include "core/Error.h"
 #include "preprocess/BrickBinning.h"
+#include "preprocess/DirectFile.h"
 #include "preprocess/FiniteBounds.h"
 #include "preprocess/store/FrameFile.h"
 #include "preprocess/store/StoreLock.h"
@@ -33,7 +34,6 @@ namespace {
 using detail::KeyBatch;
 using detail::KeyGrid;
 
-constexpr std::size_t kSpillBufferBytes = 64 << 10;
 /// Spill files are `<kSpillPrefix><pid>-<frame>[-<n>]-<bucket>`.
 constexpr std::string_view kSpillPrefix = ".flipscope-spill-";
 
@@ -68,24 +68,29 @@ struct MemoryPlan {
     const std::uint64_t perParticle = separateValues ? 12 : 8;  // key (+ value): binning sorts in place
     chunkParticles = std::clamp<std::uint64_t>(budget / 256 / 24, 4096, 1 << 20);
     maxBinParticles = std::max<std::uint64_t>(budget * 6 / 10 / perParticle, 1 << 16);
-    maxBucketFiles = std::clamp<std::uint64_t>(budget / 8 / kSpillBufferBytes, 2, 256);
+    // An eighth of the budget buffers the spill files: up to 256 of up to 1 MiB (direct writes of
+    // 64 KiB ran at half the disk's speed of 1 MiB ones here).
+    spillBufferBytes = std::clamp<std::uint64_t>(budget / 8 / 256 / detail::kDirectBlock, 16, 256) * detail::kDirectBlock;
+    maxBucketFiles = std::clamp<std::uint64_t>(budget / 8 / spillBufferBytes, 2, 256);
   }
   std::uint64_t chunkParticles;   ///< particles read at once
   std::uint64_t maxBinParticles;  ///< particles binned in memory at once
   std::uint64_t maxBucketFiles;   ///< spill files open at once
+  std::uint64_t spillBufferBytes; ///< buffer of each, a multiple of kDirectBlock
 };
 
 /// Spill record: the batch key (KeyBatch), then the attribute value when it travels beside it.
 std::size_t recordBytes(bool values) { return values ? 12 : 8; }
 
 /// Bucket files of one partition level: bucket b holds the batch keys whose digit
-/// (key >> shift) & (count - 1) is b, with their values when `values`. Files are removed on
-/// destruction.
+/// (key >> shift) & (count - 1) is b, with their values when `values`. Written and read as
+/// DirectFiles, in blocks: a bucket's last block is padded, its record count says where its
+/// records end. Files are removed on destruction.
 class SpillBuckets {
  public:
   SpillBuckets(const std::filesystem::path& dir, const std::string& prefix, std::uint32_t shift, std::uint32_t bits,
-               bool values)
-      : mShift(shift), mBits(bits), mValues(values) {
+               bool values, std::size_t bufferBytes)
+      : mShift(shift), mBits(bits), mValues(values), mBufferBytes(bufferBytes) {
     const std::size_t count = std::size_t(1) << bits;
     for (std::size_t b = 0; b < count; ++b) {
       Bucket bucket;
@@ -95,7 +100,7 @@ class SpillBuckets {
   }
   ~SpillBuckets() {
     for (auto& b : mBuckets) {
-      if (b.file) std::fclose(b.file);
+      b.file.reset();
       std::error_code ec;
       std::filesystem::remove(b.path, ec);
       b.cleanup.release();
@@ -106,59 +111,75 @@ class SpillBuckets {
 
   void add(const std::uint64_t* keys, const float* values, std::size_t n) {
     const std::uint64_t mask = (1ull << mBits) - 1;
+    const std::size_t bytes = recordBytes(mValues);
     for (std::size_t i = 0; i < n; ++i) {
       Bucket& b = mBuckets[(keys[i] >> mShift) & mask];
-      auto* p = reinterpret_cast<const std::byte*>(&keys[i]);
-      b.buffer.insert(b.buffer.end(), p, p + 8);
-      if (mValues) {
-        auto* s = reinterpret_cast<const std::byte*>(&values[i]);
-        b.buffer.insert(b.buffer.end(), s, s + 4);
-      }
+      if (b.buffer.size() == 0) b.buffer = detail::AlignedBuffer(mBufferBytes);
+      std::byte* record = b.buffer.data() + b.used;
+      std::memcpy(record, &keys[i], 8);
+      if (mValues) std::memcpy(record + 8, &values[i], 4);
+      b.used += bytes;
       ++b.records;
-      if (b.buffer.size() >= kSpillBufferBytes) flush(b);
+      if (b.used + bytes > b.buffer.size()) flush(b, false);
     }
   }
   void finish() {
     for (auto& b : mBuckets) {
-      flush(b);
-      if (b.file) {
-        std::fclose(b.file);
-        b.file = nullptr;
-      }
-      std::vector<std::byte>().swap(b.buffer);
+      flush(b, true);
+      b.file.reset();
+      b.buffer = {};
     }
   }
   std::size_t size() const { return mBuckets.size(); }
   std::uint64_t records(std::size_t b) const { return mBuckets[b].records; }
   std::uint32_t shift() const { return mShift; }
 
-  /// Streams bucket b (after finish()) in pieces of at most 8192 records:
-  /// fn(const uint64_t* keys, const float* values, size_t n); values is null without attribute.
+  /// Streams bucket b (after finish()) in pieces:
+  /// fn(const uint64_t* keys, const float* values, size_t n); values is null without them.
   template <class Fn>
   void forEachPiece(std::size_t b, Fn&& fn) const {
     const Bucket& bucket = mBuckets[b];
     if (!bucket.records) return;
-    std::FILE* f = std::fopen(bucket.path.c_str(), "rb");
-    if (!f) throw FileError(bucket.path, "cannot reopen spill file");
-    constexpr std::size_t kPiece = 8192;
+    detail::DirectFile file(bucket.path, detail::DirectFile::Mode::Read);
     const std::size_t bytes = recordBytes(mValues);
-    std::vector<std::byte> buffer(bytes * kPiece);
-    std::vector<std::uint64_t> keys(kPiece);
-    std::vector<float> values(mValues ? kPiece : 0);
+    detail::AlignedBuffer block(mBufferBytes);
+    std::vector<std::uint64_t> keys;
+    std::vector<float> values;
+    std::byte carry[16];  // a record split across two blocks
+    std::size_t carried = 0;
     for (std::uint64_t done = 0; done < bucket.records;) {
-      const std::size_t n = std::min<std::uint64_t>(kPiece, bucket.records - done);
-      if (std::fread(buffer.data(), bytes, n, f) != n) {
-        std::fclose(f);
-        throw FileError(bucket.path, "spill file shorter than written");
+      const std::size_t got = file.read({block.data(), block.size()});
+      if (got == 0) throw FileError(bucket.path, "spill file shorter than written");
+      keys.clear();
+      values.clear();
+      std::size_t at = 0;
+      auto take = [&](const std::byte* record) {
+        std::uint64_t key;
+        std::memcpy(&key, record, 8);
+        keys.push_back(key);
+        if (mValues) {
+          float value;
+          std::memcpy(&value, record + 8, 4);
+          values.push_back(value);
+        }
+        ++done;
+      };
+      if (carried) {
+        at = std::min(bytes - carried, got);
+        std::memcpy(carry + carried, block.data(), at);
+        carried += at;
+        if (carried == bytes) {
+          take(carry);
+          carried = 0;
+        }
       }
-      for (std::size_t i = 0; i < n; ++i) {
-        std::memcpy(&keys[i], buffer.data() + i * bytes, 8);
-        if (mValues) std::memcpy(&values[i], buffer.data() + i * bytes + 8, 4);
+      for (; at + bytes <= got && done < bucket.records; at += bytes) take(block.data() + at);
+      if (done < bucket.records && at < got) {
+        carried = got - at;
+        std::memcpy(carry, block.data() + at, carried);
       }
-      fn(keys.data(), mValues ? values.data() : nullptr, n);
-      done += n;
+      fn(keys.data(), mValues ? values.data() : nullptr, keys.size());
     }
-    std::fclose(f);
   }
 
   /// Loads bucket b (after finish()) into `batch`.
@@ -173,36 +194,43 @@ class SpillBuckets {
  private:
   struct Bucket {
     std::filesystem::path path;
-    std::FILE* file = nullptr;
-    std::vector<std::byte> buffer;
+    std::unique_ptr<detail::DirectFile> file;
+    detail::AlignedBuffer buffer;  ///< allocated at the bucket's first record
+    std::size_t used = 0;          ///< bytes of buffer not yet written
     std::uint64_t records = 0;
     CleanupOnSignal cleanup;  ///< from before the file exists until it is removed
   };
-  void flush(Bucket& b) {
-    if (b.buffer.empty()) return;
+  /// Writes the buffer's whole blocks; at the end (`last`), all of it, its last block padded.
+  void flush(Bucket& b, bool last) {
+    const std::size_t whole = last ? (b.used + detail::kDirectBlock - 1) / detail::kDirectBlock * detail::kDirectBlock
+                                   : b.used / detail::kDirectBlock * detail::kDirectBlock;
+    if (whole == 0) return;
     if (!b.file) {
       const DeferCleanupSignals step;  // registered and created as one step
       b.cleanup = CleanupOnSignal(b.path);
-      b.file = std::fopen(b.path.c_str(), "wb");
-      if (!b.file) throw FileError(b.path, std::string("cannot create spill file: ") + std::strerror(errno));
+      b.file = std::make_unique<detail::DirectFile>(b.path, detail::DirectFile::Mode::Create);
     }
-    if (std::fwrite(b.buffer.data(), 1, b.buffer.size(), b.file) != b.buffer.size())
-      throw FileError(b.path, std::string("spill write failed (disk full?): ") + std::strerror(errno));
-    b.buffer.clear();
+    if (whole > b.used) std::memset(b.buffer.data() + b.used, 0, whole - b.used);
+    b.file->append({b.buffer.data(), whole});
+    b.used = whole > b.used ? 0 : b.used - whole;
+    std::memmove(b.buffer.data(), b.buffer.data() + whole, b.used);
     stopPoint("spill");
   }
 
   std::uint32_t mShift, mBits;
   bool mValues;
+  std::size_t mBufferBytes;
   std::vector<Bucket> mBuckets;
 };
 
 /// Bins one frame's keys: in memory while they fit, spilled to buckets beyond.
 class FrameBinner {
  public:
+  /// `expectedParticles`: the source's count hint, when it gives one.
   FrameBinner(const KeyGrid& grid, const MemoryPlan& plan, const ConvertOptions& options,
-              std::filesystem::path scratchDir, int frame)
+              std::filesystem::path scratchDir, int frame, std::optional<std::uint64_t> expectedParticles)
       : mGrid(grid),
+        mSpillFromStart(expectedParticles && *expectedParticles > plan.maxBinParticles),
         mValues(grid.attribute() && !grid.valueInKey),
         mPlan(plan),
         mOptions(options),
@@ -212,6 +240,7 @@ class FrameBinner {
   /// With particle kinds, the chunk's last column holds the type flags (convertFrame).
   void add(const ParticleChunk& chunk) {
     const AttributeColumn* types = mGrid.header.particleKinds ? &chunk.attributes.back() : nullptr;
+    if (!mSpill && mSpillFromStart) startSpilling();  // binning in memory first would only add memory
     if (mSpill) {
       mBatch.clear();
       account(detail::computeKeys(chunk, mGrid, mBatch, types));
@@ -259,13 +288,18 @@ class FrameBinner {
   void startSpilling() {
     const std::uint32_t bits = bucketBitsFor(mGrid.codeBits);
     const std::uint32_t shift = mGrid.cellKeyShift() + mGrid.cellBits + mGrid.codeBits - bits;
-    mSpill = std::make_unique<SpillBuckets>(mScratch, mPrefix, shift, bits, mValues);
+    mSpill = std::make_unique<SpillBuckets>(mScratch, mPrefix, shift, bits, mValues, mPlan.spillBufferBytes);
     mSpill->add(mKeys.cellKeys.data(), mKeys.values.data(), mKeys.cellKeys.size());
     mKeys.clear();
     mSpillBuckets += std::uint32_t(mSpill->size());
   }
 
   void binBuckets(const SpillBuckets& buckets, FrameWriter& writer) {
+    std::uint64_t largest = 0;  // of the buckets binned in memory: reserved once, no reallocation copies
+    for (std::size_t b = 0; b < buckets.size(); ++b)
+      if (buckets.records(b) <= mPlan.maxBinParticles) largest = std::max(largest, buckets.records(b));
+    mKeys.cellKeys.reserve(largest);
+    if (mValues) mKeys.values.reserve(largest);
     for (std::size_t b = 0; b < buckets.size(); ++b) {
       if (buckets.records(b) == 0) continue;
       if (buckets.records(b) <= mPlan.maxBinParticles) {
@@ -279,7 +313,8 @@ class FrameBinner {
         throw InputError("a single brick holds " + std::to_string(buckets.records(b)) +
                          " particles, more than --mem allows binning at once; raise --mem or use a smaller cell size");
       const std::uint32_t bits = bucketBitsFor(remaining);
-      SpillBuckets sub(mScratch, mPrefix + "-" + std::to_string(mSpillBuckets), buckets.shift() - bits, bits, mValues);
+      SpillBuckets sub(mScratch, mPrefix + "-" + std::to_string(mSpillBuckets), buckets.shift() - bits, bits, mValues,
+                       mPlan.spillBufferBytes);
       mSpillBuckets += std::uint32_t(sub.size());
       buckets.forEachPiece(b, [&](const std::uint64_t* k, const float* s, std::size_t n) { sub.add(k, s, n); });
       sub.finish();
@@ -300,6 +335,7 @@ class FrameBinner {
   }
 
   const KeyGrid& mGrid;
+  bool mSpillFromStart;  ///< the source's count says the frame will not fit in memory
   bool mValues;  ///< attribute values travel beside the keys (not KeyGrid::valueInKey)
   MemoryPlan mPlan;
   const ConvertOptions& mOptions;
@@ -768,7 +804,7 @@ FrameReport convertOneFrame(ParticleSource& source, BrickStore& store, int frame
   const MemoryPlan plan(options.memoryBudget, attribute && !grid.valueInKey);
   const std::filesystem::path scratch = options.scratchDir.empty() ? store.directory() : options.scratchDir;
 
-  FrameBinner binner(grid, plan, options, scratch, frame);
+  FrameBinner binner(grid, plan, options, scratch, frame, source.countHint());
   ParticleChunk chunk;
   std::optional<PrefetchingSource> ahead;  // the next chunk is read while this one is binned
   ParticleSource& input = readingAhead(source, options.readAhead, ahead);

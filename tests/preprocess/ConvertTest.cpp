@@ -176,7 +176,7 @@ TEST_P(ConvertOutOfCore, StoreIsByteIdenticalToInCoreWithAndWithoutReadAhead) {
   const Box domain{{0, 0, 0}, {50, 50, 50}};
   ASSERT_EQ(detail::KeyGrid(makeStoreHeader(domain, options, AttributeKind::Speed)).valueInKey, c.valueInKey);
   testing::TempDir temp("out-of-core");
-  auto run = [&](std::uint64_t budget, const std::string& name, bool readAhead = true) {
+  auto run = [&](std::uint64_t budget, const std::string& name, bool readAhead = true, bool hintsCount = true) {
     options.memoryBudget = budget;
     options.readAhead = readAhead;
     const fs::path dir = temp / name;
@@ -184,6 +184,7 @@ TEST_P(ConvertOutOfCore, StoreIsByteIdenticalToInCoreWithAndWithoutReadAhead) {
     header.id = {7, 7, 7};  // the same id for both stores: then the files are the same bytes
     BrickStore store = BrickStore::createOrAppend(dir, header);
     testing::VectorSource source(positions, velocities);
+    source.hintsCount = hintsCount;
     FrameReport report = convertFrame(source, store, 1, options);
     return std::make_pair(dir, report);
   };
@@ -200,6 +201,11 @@ TEST_P(ConvertOutOfCore, StoreIsByteIdenticalToInCoreWithAndWithoutReadAhead) {
     EXPECT_EQ(report.spillBuckets > 0, budget < (1ull << 30)) << name;
     EXPECT_EQ(readFile(dir / "frame_000001.fsf"), readFile(inCore / "frame_000001.fsf")) << name;
   }
+  // A source that gives its count spills from its first chunk; one that does not is binned in
+  // memory until it overflows, then spills what it holds.
+  const auto [unhinted, unhintedReport] = run(4ull << 20, "ooc-no-count", true, false);
+  EXPECT_GT(unhintedReport.spillBuckets, 1u);
+  EXPECT_EQ(readFile(unhinted / "frame_000001.fsf"), readFile(inCore / "frame_000001.fsf"));
   // No spill file is left behind.
   for (const auto& e : fs::directory_iterator(outOfCore))
     EXPECT_TRUE(e.path().filename() == "store.fsh" || e.path().filename() == "store.lock" ||

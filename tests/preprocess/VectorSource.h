@@ -16,7 +16,10 @@ class VectorSource : public ParticleSource {
   std::string name() const override { return "memory"; }
   std::string format() const override { return "particles in memory"; }
   bool hasVelocity() const override { return !mVelocities.empty(); }
-  std::optional<std::uint64_t> countHint() const override { return mPositions.size(); }
+  std::optional<std::uint64_t> countHint() const override {
+    return hintsCount ? std::optional<std::uint64_t>(mPositions.size()) : std::nullopt;
+  }
+  bool hintsCount = true;  ///< whether countHint() gives the count
   bool read(ParticleChunk& chunk, std::size_t maxParticles) override {
     chunk.clear();
     const std::size_t n = std::min(maxParticles, mPositions.size() - mNext);

@@ -1,0 +1,59 @@
+// DirectFile: a scratch file written and read in aligned blocks with O_DIRECT where the file
+// system takes it (else through the page cache), for out-of-core binning's spill files.
+//
+// Why not the page cache: spill files are written once, read once and removed, so caching them
+// gains nothing, and each page they take is fresh memory. On the virtual machines we measured
+// (the development machine, 2026-12-03), copying 4 GB of spill records into fresh page-cache
+// folios was a third of a 500 M particle convert; a direct write of 1 MiB blocks runs at the
+// disk's speed from our own, already touched, buffers.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <span>
+
+namespace flipscope::detail {
+
+/// Block size of direct I/O: buffer addresses, lengths and file offsets are multiples of it.
+inline constexpr std::size_t kDirectBlock = 4096;
+
+/// A heap buffer aligned to kDirectBlock.
+class AlignedBuffer {
+ public:
+  AlignedBuffer() = default;
+  explicit AlignedBuffer(std::size_t bytes);  ///< rounded up to kDirectBlock; contents undefined
+  std::byte* data() const { return mData.get(); }
+  std::size_t size() const { return mSize; }
+
+ private:
+  struct Free {
+    void operator()(std::byte* p) const;
+  };
+  std::unique_ptr<std::byte, Free> mData;
+  std::size_t mSize = 0;
+};
+
+class DirectFile {
+ public:
+  enum class Mode { Create, Read };
+  /// Creates (truncating) or opens `path`. Throws FileError naming it.
+  DirectFile(const std::filesystem::path& path, Mode mode);
+  ~DirectFile();
+  DirectFile(const DirectFile&) = delete;
+  DirectFile& operator=(const DirectFile&) = delete;
+
+  /// Appends `bytes` (a multiple of kDirectBlock, from an AlignedBuffer). Throws FileError
+  /// (disk full, I/O error).
+  void append(std::span<const std::byte> bytes);
+  /// Reads the next bytes into `into` (a multiple of kDirectBlock long, from an AlignedBuffer);
+  /// returns how many were read: fewer only at the end of the file.
+  std::size_t read(std::span<std::byte> into);
+
+ private:
+  std::filesystem::path mPath;
+  int mFd = -1;
+};
+
+}  // namespace flipscope::detail
