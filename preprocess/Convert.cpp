@@ -90,7 +90,7 @@ class SpillBuckets {
  public:
   SpillBuckets(const std::filesystem::path& dir, const std::string& prefix, std::uint32_t shift, std::uint32_t bits,
                bool values, std::size_t bufferBytes)
-      : mShift(shift), mBits(bits), mValues(values), mBufferBytes(bufferBytes) {
+      : mShift(shift), mBits(bits), mValues(values), mBufferBytes(bufferBytes), mAppender(bufferBytes, kQueuedBlocks) {
     const std::size_t count = std::size_t(1) << bits;
     for (std::size_t b = 0; b < count; ++b) {
       Bucket bucket;
@@ -114,7 +114,7 @@ class SpillBuckets {
     const std::size_t bytes = recordBytes(mValues);
     for (std::size_t i = 0; i < n; ++i) {
       Bucket& b = mBuckets[(keys[i] >> mShift) & mask];
-      if (b.buffer.size() == 0) b.buffer = detail::AlignedBuffer(mBufferBytes);
+      if (b.buffer.size() == 0) b.buffer = mAppender.take();
       std::byte* record = b.buffer.data() + b.used;
       std::memcpy(record, &keys[i], 8);
       if (mValues) std::memcpy(record + 8, &values[i], 4);
@@ -124,11 +124,9 @@ class SpillBuckets {
     }
   }
   void finish() {
-    for (auto& b : mBuckets) {
-      flush(b, true);
-      b.file.reset();
-      b.buffer = {};
-    }
+    for (auto& b : mBuckets) flush(b, true);
+    mAppender.drain();
+    for (auto& b : mBuckets) b.file.reset();
   }
   std::size_t size() const { return mBuckets.size(); }
   std::uint64_t records(std::size_t b) const { return mBuckets[b].records; }
@@ -142,7 +140,7 @@ class SpillBuckets {
     if (!bucket.records) return;
     detail::DirectFile file(bucket.path, detail::DirectFile::Mode::Read);
     const std::size_t bytes = recordBytes(mValues);
-    detail::AlignedBuffer block(mBufferBytes);
+    detail::AlignedBuffer block(4 * mBufferBytes);  // the spill buffers are free by now (finish())
     std::vector<std::uint64_t> keys;
     std::vector<float> values;
     std::byte carry[16];  // a record split across two blocks
@@ -164,6 +162,12 @@ class SpillBuckets {
         }
         ++done;
       };
+      if (!mValues) {  // the records are the keys: handed over where they lie (8-byte records never straddle)
+        const std::size_t n = std::min<std::uint64_t>(got / 8, bucket.records - done);
+        done += n;
+        fn(reinterpret_cast<const std::uint64_t*>(block.data()), nullptr, n);
+        continue;
+      }
       if (carried) {
         at = std::min(bytes - carried, got);
         std::memcpy(carry + carried, block.data(), at);
@@ -200,7 +204,8 @@ class SpillBuckets {
     std::uint64_t records = 0;
     CleanupOnSignal cleanup;  ///< from before the file exists until it is removed
   };
-  /// Writes the buffer's whole blocks; at the end (`last`), all of it, its last block padded.
+  /// Queues the buffer's whole blocks for writing; at the end (`last`), all of it, its last
+  /// block padded. What is left moves to a buffer of its own.
   void flush(Bucket& b, bool last) {
     const std::size_t whole = last ? (b.used + detail::kDirectBlock - 1) / detail::kDirectBlock * detail::kDirectBlock
                                    : b.used / detail::kDirectBlock * detail::kDirectBlock;
@@ -211,16 +216,26 @@ class SpillBuckets {
       b.file = std::make_unique<detail::DirectFile>(b.path, detail::DirectFile::Mode::Create);
     }
     if (whole > b.used) std::memset(b.buffer.data() + b.used, 0, whole - b.used);
-    b.file->append({b.buffer.data(), whole});
-    b.used = whole > b.used ? 0 : b.used - whole;
-    std::memmove(b.buffer.data(), b.buffer.data() + whole, b.used);
+    detail::AlignedBuffer rest;
+    const std::size_t left = last ? 0 : b.used - whole;
+    if (!last) {
+      rest = mAppender.take();
+      std::memcpy(rest.data(), b.buffer.data() + whole, left);
+    }
+    mAppender.append(*b.file, std::move(b.buffer), whole);
+    b.buffer = std::move(rest);
+    b.used = left;
     stopPoint("spill");
   }
+
+  /// Blocks being written at once: the disk works while the binning computes.
+  static constexpr std::size_t kQueuedBlocks = 4;
 
   std::uint32_t mShift, mBits;
   bool mValues;
   std::size_t mBufferBytes;
   std::vector<Bucket> mBuckets;
+  detail::BackgroundAppender mAppender;  ///< after mBuckets: destroyed first, its writes done before the files close
 };
 
 /// Bins one frame's keys: in memory while they fit, spilled to buckets beyond.

@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
+#include <algorithm>
 #include <new>
 #include <string>
 
@@ -55,6 +56,75 @@ std::size_t DirectFile::read(std::span<std::byte> into) {
     done += std::size_t(n);
   }
   return done;
+}
+
+BackgroundAppender::BackgroundAppender(std::size_t bufferBytes, std::size_t maxQueued)
+    : mBufferBytes(bufferBytes), mMaxQueued(std::max<std::size_t>(maxQueued, 1)), mThread([this] { run(); }) {}
+
+BackgroundAppender::~BackgroundAppender() {
+  {
+    std::unique_lock lock(mMutex);
+    mChanged.wait(lock, [&] { return mQueue.empty() && !mWriting; });
+    mStop = true;
+  }
+  mChanged.notify_all();
+  mThread.join();
+}
+
+AlignedBuffer BackgroundAppender::take() {
+  std::lock_guard lock(mMutex);
+  if (mFree.empty()) return AlignedBuffer(mBufferBytes);
+  AlignedBuffer buffer = std::move(mFree.back());
+  mFree.pop_back();
+  return buffer;
+}
+
+void BackgroundAppender::append(DirectFile& file, AlignedBuffer buffer, std::size_t bytes) {
+  {
+    std::unique_lock lock(mMutex);
+    mChanged.wait(lock, [&] { return mQueue.size() < mMaxQueued || mError; });
+    throwError();
+    mQueue.push_back({&file, std::move(buffer), bytes});
+  }
+  mChanged.notify_all();
+}
+
+void BackgroundAppender::drain() {
+  std::unique_lock lock(mMutex);
+  mChanged.wait(lock, [&] { return (mQueue.empty() && !mWriting) || mError; });
+  throwError();
+  mFree.clear();
+}
+
+void BackgroundAppender::throwError() {
+  if (!mError) return;
+  std::exception_ptr error = mError;
+  mError = nullptr;
+  mQueue.clear();  // what followed the failed block is not written either
+  std::rethrow_exception(error);
+}
+
+void BackgroundAppender::run() {
+  std::unique_lock lock(mMutex);
+  for (;;) {
+    mChanged.wait(lock, [&] { return !mQueue.empty() || mStop; });
+    if (mQueue.empty()) return;  // stopping
+    Job job = std::move(mQueue.front());
+    mQueue.pop_front();
+    mWriting = true;
+    lock.unlock();
+    std::exception_ptr error;
+    try {
+      job.file->append({job.buffer.data(), job.bytes});
+    } catch (...) {
+      error = std::current_exception();
+    }
+    lock.lock();
+    mWriting = false;
+    if (error && !mError) mError = error;
+    mFree.push_back(std::move(job.buffer));
+    mChanged.notify_all();
+  }
 }
 
 }  // namespace flipscope::detail

@@ -8,11 +8,17 @@
 // disk's speed from our own, already touched, buffers.
 #pragma once
 
+#include <condition_variable>
 #include <cstddef>
 #include <cstdint>
+#include <deque>
+#include <exception>
 #include <filesystem>
 #include <memory>
+#include <mutex>
 #include <span>
+#include <thread>
+#include <vector>
 
 namespace flipscope::detail {
 
@@ -54,6 +60,45 @@ class DirectFile {
  private:
   std::filesystem::path mPath;
   int mFd = -1;
+};
+
+/// Appends blocks to DirectFiles on a thread of its own, so that the caller goes on computing
+/// while the disk writes, with at most `maxQueued` blocks waiting. Buffers come from take() and
+/// go back to its pool once written. A write error comes back from the next call.
+class BackgroundAppender {
+ public:
+  BackgroundAppender(std::size_t bufferBytes, std::size_t maxQueued);
+  ~BackgroundAppender();  ///< waits for the blocks queued (their errors are dropped)
+  BackgroundAppender(const BackgroundAppender&) = delete;
+  BackgroundAppender& operator=(const BackgroundAppender&) = delete;
+
+  /// A buffer of bufferBytes: one written before, or a new one.
+  AlignedBuffer take();
+  /// Queues buffer's first `bytes` (a multiple of kDirectBlock) to be appended to `file`, which
+  /// must outlive the write (drain()). Waits while maxQueued blocks are queued.
+  void append(DirectFile& file, AlignedBuffer buffer, std::size_t bytes);
+  /// Waits until every queued block is written and frees the buffers of the pool; throws the
+  /// first write error.
+  void drain();
+
+ private:
+  struct Job {
+    DirectFile* file;
+    AlignedBuffer buffer;
+    std::size_t bytes;
+  };
+  void run();
+  void throwError();  ///< with mMutex held
+
+  std::size_t mBufferBytes, mMaxQueued;
+  std::mutex mMutex;
+  std::condition_variable mChanged;
+  std::deque<Job> mQueue;
+  bool mWriting = false;  ///< a job taken from the queue is being written
+  bool mStop = false;
+  std::exception_ptr mError;
+  std::vector<AlignedBuffer> mFree;
+  std::thread mThread;  ///< last: started once the members above exist
 };
 
 }  // namespace flipscope::detail
