@@ -36,6 +36,9 @@ constexpr std::size_t kDenseCells = std::size_t(1) << 22;
 /// lies in the 27 cells around: those of frames of a few billion particles.
 constexpr std::size_t kMaskCells = std::size_t(1) << 22;
 constexpr std::size_t kNearCells = std::size_t(1) << 29;
+/// The near-query bits (KthNeighbours::buildNearQueryBits): cells of half the radius, at most
+/// this many (4 MiB of bits; coarser cells beyond).
+constexpr double kNearQueryCells = double(std::size_t(1) << 25);
 
 /// Spacing per k-th neighbour distance r: at spacing r * ballFactor(), a ball of radius r holds k particles.
 double ballFactor() { return std::cbrt(4 * std::numbers::pi / (3 * double(kSpacingNeighbour))); }
@@ -134,7 +137,10 @@ class KthNeighbours {
     const glm::dvec3 extent = (hi - lo) / mCell;
     mUsable = queries.positions.size() > 0 && mCell > 0 && std::isfinite(mCell) &&
               std::max({extent.x, extent.y, extent.z}) < double(1 << 30);
-    if (mUsable) buildTable();
+    if (mUsable) {
+      buildTable();
+      buildNearQueryBits();
+    }
   }
 
   /// Candidates with consecutive ids from `firstId` (the source's order).
@@ -146,17 +152,25 @@ class KthNeighbours {
     addAll(candidates.size(), [&](std::size_t i) { return std::pair(candidates[i], ids[i]); });
   }
 
+  /// Each query's k-th neighbour distance, +inf where it lies beyond the radius.
+  std::vector<double> distances() const {
+    const std::size_t n = mQueries.positions.size();
+    std::vector<double> kth(n, std::numeric_limits<double>::infinity());
+    if (!mUsable) return kth;
+    const double radius2 = mRadius * mRadius;
+    for (std::size_t j = 0; j < n; ++j) {
+      const double d2 = mHeaps[j * kNeighbours];  // the heap's maximum: the k-th smallest
+      if (d2 <= radius2) kth[j] = std::sqrt(d2);
+    }
+    return kth;
+  }
+
   /// The median k-th neighbour distance: exact when more than half the queries found theirs
   /// within the radius (the others' lie farther), else +inf.
   double median() const {
     const std::size_t n = mQueries.positions.size();
     if (!mUsable || n == 0) return std::numeric_limits<double>::infinity();
-    const double radius2 = mRadius * mRadius;
-    std::vector<double> kth(n);
-    for (std::size_t j = 0; j < n; ++j) {
-      const double d2 = mHeaps[j * kNeighbours];  // the heap's maximum: the k-th smallest
-      kth[j] = d2 <= radius2 ? std::sqrt(d2) : std::numeric_limits<double>::infinity();
-    }
+    std::vector<double> kth = distances();
     auto mid = kth.begin() + std::ptrdiff_t(n / 2);
     std::nth_element(kth.begin(), mid, kth.end());
     return *mid;
@@ -244,6 +258,67 @@ class KthNeighbours {
     }
   }
 
+  /// A bit per cell of a grid finer than the query cells (half the radius) over [mLo, mHi]: set
+  /// where a query lies within the radius of some point of the cell. A candidate whose cell's
+  /// bit is clear has no query within the radius and is turned away with one lookup. Cells are
+  /// set with a margin (kSlack) so that rounding in the candidate's cell index never turns away
+  /// one that has; the search itself (visit) stays exact. Without these bits half the
+  /// candidates of a frame passed the coarser block mask below; with them about a tenth do.
+  void buildNearQueryBits() {
+    const glm::dvec3 extent = mHi - mLo;
+    double cell = mRadius / 2;
+    const auto cellsFor = [&](double c) { return glm::floor(extent / c) + 1.0; };
+    glm::dvec3 dims = cellsFor(cell);
+    if (const double count = dims.x * dims.y * dims.z; !(count <= kNearQueryCells)) {
+      cell *= std::cbrt(count / kNearQueryCells) * 1.01;
+      dims = cellsFor(cell);
+    }
+    if (!(dims.x * dims.y * dims.z <= kNearQueryCells)) return;  // (extents beyond doubles' reach: no bits)
+    mNearQueryCell = cell;
+    mNearQueryInverse = 1 / cell;
+    mNearQueryDims = glm::ivec3(dims);
+    mNearQueryBits.assign((std::size_t(dims.x * dims.y * dims.z) + 63) / 64, 0);
+    constexpr double kSlack = 1e-6;
+    const double reach = mRadius * (1 + kSlack) + cell * kSlack;
+    std::vector<double> distance[3];  // per axis, from the query to each cell of its range
+    for (const glm::vec3& query : mQueries.positions) {
+      const glm::dvec3 q(query);
+      glm::ivec3 first, last;
+      for (int a = 0; a < 3; ++a) {
+        first[a] = std::max(0, int(std::floor((q[a] - reach - mLo[a]) * mNearQueryInverse)));
+        last[a] = std::min(mNearQueryDims[a] - 1, int(std::floor((q[a] + reach - mLo[a]) * mNearQueryInverse)));
+        distance[a].clear();
+        for (int i = first[a]; i <= last[a]; ++i) {
+          const double lo = mLo[a] + i * cell, hi = lo + cell;
+          const double d = std::max({lo - q[a], 0.0, q[a] - hi});
+          distance[a].push_back(d * d);
+        }
+      }
+      const double reach2 = reach * reach;
+      for (int z = first.z; z <= last.z; ++z)
+        for (int y = first.y; y <= last.y; ++y) {
+          const double yz = distance[2][std::size_t(z - first.z)] + distance[1][std::size_t(y - first.y)];
+          if (yz > reach2) continue;
+          const std::size_t row = (std::size_t(z) * std::size_t(mNearQueryDims.y) + std::size_t(y)) * std::size_t(mNearQueryDims.x);
+          for (int x = first.x; x <= last.x; ++x) {
+            if (yz + distance[0][std::size_t(x - first.x)] > reach2) continue;
+            const std::size_t bit = row + std::size_t(x);
+            mNearQueryBits[bit / 64] |= std::uint64_t(1) << (bit % 64);
+          }
+        }
+    }
+  }
+
+  /// Whether the near-query bits let candidate p (inside [mLo, mHi]) through.
+  bool mayHaveQueryNear(const glm::dvec3& p) const {
+    if (mNearQueryBits.empty()) return true;
+    const glm::dvec3 g = (p - mLo) * mNearQueryInverse;  // >= 0: p is inside
+    const glm::ivec3 c = glm::min(glm::ivec3(g), mNearQueryDims - 1);
+    const std::size_t bit =
+        (std::size_t(c.z) * std::size_t(mNearQueryDims.y) + std::size_t(c.y)) * std::size_t(mNearQueryDims.x) + std::size_t(c.x);
+    return mNearQueryBits[bit / 64] >> (bit % 64) & 1;
+  }
+
   /// The side (-1 or 1) of `axis` of octant o: bit `axis` of o set is the upper half.
   static int octantSide(int octant, int axis) { return octant >> axis & 1 ? 1 : -1; }
   /// Index into mBlockMask (or bit of mNearBits) of a cell in [-1, mDims] on every axis.
@@ -304,6 +379,7 @@ class KthNeighbours {
     if (!isFinite(candidate)) return;
     const glm::dvec3 p(candidate);
     if (p.x < mLo.x || p.y < mLo.y || p.z < mLo.z || p.x > mHi.x || p.y > mHi.y || p.z > mHi.z) return;
+    if (!mayHaveQueryNear(p)) return;
     const glm::dvec3 f = gridPoint(p);
     const glm::dvec3 base = fastFloor(f);
     const glm::ivec3 cell(base);
@@ -341,6 +417,9 @@ class KthNeighbours {
   std::vector<std::uint8_t> mBlockMask;    ///< small grids: see buildTable()
   std::vector<std::uint64_t> mNearBits;    ///< larger grids: see buildTable()
   std::vector<Slot> mTable;                ///< else: the cells with queries, hashed
+  double mNearQueryCell = 0, mNearQueryInverse = 0;  ///< see buildNearQueryBits()
+  glm::ivec3 mNearQueryDims{0};
+  std::vector<std::uint64_t> mNearQueryBits;
   std::size_t mMask = 0;
   std::vector<float> mHeaps;  ///< k squared distances per query, a max-heap each
   tbb::enumerable_thread_specific<std::vector<Hit>> mHits;
@@ -435,6 +514,17 @@ SpacingEstimate neighbourSpacing(ParticleSource& source, std::size_t sampleSize,
   e.spacing = median * ballFactor();
   e.origin = "median " + std::to_string(kSpacingNeighbour) + "th-neighbour distance " + text(median) + " of " + of;
   return e;
+}
+
+std::vector<double> detail::kthNeighbourDistances(std::span<const glm::vec3> queries,
+                                                  std::span<const std::uint64_t> queryIds,
+                                                  std::span<const glm::vec3> candidates, double radius) {
+  Sample sample;
+  sample.positions.assign(queries.begin(), queries.end());
+  sample.ids.assign(queryIds.begin(), queryIds.end());
+  KthNeighbours search(sample, radius);
+  search.add(candidates, 0);
+  return search.distances();
 }
 
 SpacingEstimate neighbourSpacing(std::span<const glm::vec3> points, std::size_t sampleSize) {

@@ -65,4 +65,12 @@ SpacingEstimate neighbourSpacing(ParticleSource& source, std::size_t sampleSize 
 /// The neighbour estimate over points in memory.
 SpacingEstimate neighbourSpacing(std::span<const glm::vec3> points, std::size_t sampleSize = kSpacingSample);
 
+namespace detail {
+/// The search under the neighbour estimate: for each query, the distance to its
+/// kSpacingNeighbour-th nearest candidate, +inf where that lies beyond `radius`. Candidate i
+/// has id i; a candidate with a query's id is that query itself and does not count.
+std::vector<double> kthNeighbourDistances(std::span<const glm::vec3> queries, std::span<const std::uint64_t> queryIds,
+                                          std::span<const glm::vec3> candidates, double radius);
+}  // namespace detail
+
 }  // namespace flipscope

@@ -65,6 +65,61 @@ TEST(ParticleSpacing, JitteredAndRandomPointsGiveTheirSpacing) {
   EXPECT_NEAR(e.spacing, 0.2, 0.05 * 0.2) << e.origin;
 }
 
+TEST(ParticleSpacing, TheSearchFindsTheKthNeighboursOfComparingEveryPair) {
+  // The search under every estimate (detail::kthNeighbourDistances): each query's 12th-neighbour
+  // distance, +inf beyond the radius, must be the one of comparing every pair (the same float
+  // arithmetic), on clusters of different densities over a sparse background, at radii around
+  // the median distance. The search turns candidates away by masks before it measures; turning
+  // away one within the radius changes that query's distance.
+  std::mt19937 rng(21);
+  std::vector<glm::vec3> candidates;
+  for (const float spread : {0.05f, 0.2f, 0.6f}) {
+    std::normal_distribution<float> blob(0.0f, spread);
+    const glm::vec3 centre(spread * 10, 1.0f, -spread * 5);
+    for (int i = 0; i < 6000; ++i) candidates.push_back(centre + glm::vec3(blob(rng), blob(rng), blob(rng)));
+  }
+  std::uniform_real_distribution<float> background(-3.0f, 8.0f);
+  for (int i = 0; i < 2000; ++i) candidates.push_back({background(rng), background(rng), background(rng)});
+  std::vector<glm::vec3> queries;
+  std::vector<std::uint64_t> ids;
+  for (std::size_t i = 0; i < candidates.size(); i += 11) {
+    queries.push_back(candidates[i]);
+    ids.push_back(i);
+  }
+  for (int i = 0; i < 50; ++i) {  // queries that are no candidate
+    queries.push_back({background(rng), background(rng), background(rng)});
+    ids.push_back(candidates.size() + std::size_t(i));
+  }
+
+  std::vector<float> kth2;  // each query's 12th smallest squared distance
+  std::vector<float> d2(candidates.size());
+  for (std::size_t q = 0; q < queries.size(); ++q) {
+    for (std::size_t c = 0; c < candidates.size(); ++c) {
+      const glm::vec3 d = queries[q] - candidates[c];
+      d2[c] = c == ids[q] ? std::numeric_limits<float>::infinity() : d.x * d.x + d.y * d.y + d.z * d.z;
+    }
+    std::nth_element(d2.begin(), d2.begin() + (kSpacingNeighbour - 1), d2.end());
+    kth2.push_back(d2[kSpacingNeighbour - 1]);
+  }
+  std::vector<float> sorted = kth2;
+  std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(sorted.size() / 2), sorted.end());
+  const double median = std::sqrt(double(sorted[sorted.size() / 2]));
+
+  for (const double radius : {0.4 * median, median, 2.5 * median}) {
+    const std::vector<double> found = detail::kthNeighbourDistances(queries, ids, candidates, radius);
+    ASSERT_EQ(found.size(), queries.size());
+    std::size_t within = 0;
+    for (std::size_t q = 0; q < queries.size(); ++q) {
+      const double expected = double(kth2[q]) <= radius * radius ? std::sqrt(double(kth2[q]))
+                                                                  : std::numeric_limits<double>::infinity();
+      within += std::isfinite(expected);
+      ASSERT_EQ(found[q], expected) << "query " << q << " at radius " << radius;
+    }
+    EXPECT_GT(within, 0u);
+    EXPECT_LT(within, queries.size()) << "some queries' 12th neighbour lies beyond the radius";
+  }
+}
+
 TEST(ParticleSpacing, SampledEstimateReadsEveryParticleForNeighbours) {
   // 40^3 particles, 2000 sampled: neighbours among the sample alone would be 3 times farther.
   const auto points = lattice(40, 0.5f, 0.5f);
