@@ -2,6 +2,7 @@
 #include "streaming/BrickSource.h"
 
 #include <algorithm>
+#include <bit>
 #include <limits>
 
 #include <glm/common.hpp>
@@ -52,10 +53,11 @@ Box occupiedBounds(BrickSource& source, int first, int last) {
   }
   const glm::dvec3 lower(lo * h.brickSize), upper((hi + 1u) * h.brickSize);
   if (outer.size() > kMaxDecoded) return Box{h.origin + lower * h.cellSize, h.origin + upper * h.cellSize};
-  // The bricks are decoded over every core (BrickSource is thread safe).
-  using CellBounds = std::pair<glm::dvec3, glm::dvec3>;
-  const CellBounds none{glm::dvec3(std::numeric_limits<double>::infinity()),
-                        glm::dvec3(-std::numeric_limits<double>::infinity())};
+  // The bricks are decoded over every core (BrickSource is thread safe). Cell indices are
+  // x + B (y + B z) with B a power of two: bounds in whole cells, as integers.
+  using CellBounds = std::pair<glm::uvec3, glm::uvec3>;  // lowest cell, highest cell + 1
+  const CellBounds none{glm::uvec3(~0u), glm::uvec3(0u)};
+  const std::uint32_t shift = std::uint32_t(std::countr_zero(h.brickSize)), mask = h.brickSize - 1;
   const CellBounds cells = tbb::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, outer.size(), 4), none,
       [&](const tbb::blocked_range<std::size_t>& range, CellBounds bounds) {
@@ -63,20 +65,24 @@ Box occupiedBounds(BrickSource& source, int first, int last) {
           const auto& [index, i] = outer[o];
           const auto brick = source.read(BrickKey{index->frame, index->bricks[i].coord});
           FLIPSCOPE_CHECK(brick, "brick " << i << " of frame " << index->frame << " listed but empty");
-          const glm::dvec3 base(index->bricks[i].coord * h.brickSize);
+          glm::uvec3 low(~0u), high(0u);
           for (std::uint32_t cell : brick->cells) {
-            const glm::dvec3 c = base + glm::dvec3(cell % h.brickSize, cell / h.brickSize % h.brickSize,
-                                                   cell / (h.brickSize * h.brickSize));
-            bounds.first = glm::min(bounds.first, c);
-            bounds.second = glm::max(bounds.second, c + 1.0);
+            const glm::uvec3 c(cell & mask, (cell >> shift) & mask, cell >> (2 * shift));
+            low = glm::min(low, c);
+            high = glm::max(high, c);
           }
+          if (brick->cells.empty()) continue;
+          const glm::uvec3 base = index->bricks[i].coord * h.brickSize;
+          bounds.first = glm::min(bounds.first, base + low);
+          bounds.second = glm::max(bounds.second, base + high + 1u);
         }
         return bounds;
       },
       [](const CellBounds& a, const CellBounds& b) {
         return CellBounds{glm::min(a.first, b.first), glm::max(a.second, b.second)};
       });
-  return Box{h.origin + cells.first * h.cellSize, h.origin + cells.second * h.cellSize};
+  if (cells.first.x > cells.second.x) return Box{h.origin + lower * h.cellSize, h.origin + upper * h.cellSize};
+  return Box{h.origin + glm::dvec3(cells.first) * h.cellSize, h.origin + glm::dvec3(cells.second) * h.cellSize};
 }
 
 }  // namespace flipscope

@@ -5,6 +5,9 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <limits>
+
+#include <glm/common.hpp>
 
 #include "core/Error.h"
 #include "core/Morton.h"
@@ -67,6 +70,58 @@ TEST_F(StoreBrickSourceTest, ReadsWhatWasWritten) {
       }
   EXPECT_EQ(source.read({0, {0, 0, 0}}), nullptr);            // no such frame
   EXPECT_EQ(source.read({1, {0xffffffffu, 0, 0}}), nullptr);  // outside the grid
+}
+
+TEST(OccupiedBounds, AreTheCellBoundsOfEveryBrick) {
+  // occupiedBounds decodes the outer bricks only; every brick's cells, one by one, give the same.
+  // A few cells in bricks of 32 on a 4x3x3 grid, none on a brick's face but one.
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("flipscope-occupied-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+  std::filesystem::remove_all(dir);
+  StoreHeader header;
+  header.brickSize = 32;
+  header.cellSize = 0.25;
+  header.origin = {-1, 2, 0.5};
+  header.brickGrid = {4, 3, 3};
+  const std::vector<std::pair<glm::uvec3, std::vector<glm::uvec3>>> bricks = {
+      {{0, 1, 2}, {{5, 7, 9}, {30, 2, 3}}},  // in Morton order
+      {{2, 0, 1}, {{1, 31, 0}}},
+      {{1, 1, 1}, {{0, 0, 0}}},  // inside: never decoded
+      {{3, 2, 0}, {{12, 4, 17}, {6, 20, 21}}},
+  };
+  {
+    BrickStore store = BrickStore::createOrAppend(dir, header);
+    std::vector<std::size_t> order(bricks.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      const glm::uvec3 p = bricks[a].first, q = bricks[b].first;
+      return mortonEncode3(p.x, p.y, p.z) < mortonEncode3(q.x, q.y, q.z);
+    });
+    FrameWriter writer(store.framePath(0), store.header(), 0);
+    FrameStats stats;
+    for (std::size_t i : order) {
+      DecodedBrick brick;
+      for (const glm::uvec3 c : bricks[i].second) brick.cells.push_back(c.x + 32 * (c.y + 32 * c.z));
+      std::sort(brick.cells.begin(), brick.cells.end());
+      brick.counts.assign(brick.cells.size(), 1);
+      writer.addBrick(bricks[i].first, std::uint32_t(brick.cells.size()), std::uint32_t(brick.cells.size()),
+                      encodeBrick(brick, 1));
+      stats.particles += brick.cells.size();
+    }
+    writer.finish(stats);
+    store.addFrame(0);
+  }
+  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
+  for (const auto& [coord, cells] : bricks)
+    for (const glm::uvec3 c : cells) {
+      lo = glm::min(lo, glm::dvec3(coord * 32u + c));
+      hi = glm::max(hi, glm::dvec3(coord * 32u + c) + 1.0);
+    }
+  StoreBrickSource source(BrickStore::open(dir));
+  const Box bounds = occupiedBounds(source, 0, 0);
+  EXPECT_EQ(bounds.min, header.origin + lo * header.cellSize);
+  EXPECT_EQ(bounds.max, header.origin + hi * header.cellSize);
+  std::filesystem::remove_all(dir);
 }
 
 TEST_F(StoreBrickSourceTest, StreamerOverTheStoreMatchesTheInMemorySource) {
