@@ -3,7 +3,8 @@
 // bits, found faster. The brick's stored cells are spread into a byte grid, zero-padded by the
 // reach, so a neighbour is one load at a fixed offset with no bounds test; each set cell counts
 // its neighbours (the offsets within the sphere radius, nearest first) and stops as soon as it has
-// the count that makes it no foam, which in a liquid body is after a few.
+// the count that makes it no foam, which in a liquid body is after a few. Eight cells of a row
+// count at once, a byte each of a 64-bit word, one load an offset for all eight.
 #pragma once
 
 #include <cstdint>
@@ -17,7 +18,8 @@ namespace flipscope {
 
 /// The byte grid and offsets one thread reuses from brick to brick.
 struct FoamNeighbourScratch {
-  std::vector<std::uint8_t> cells;
+  std::vector<std::uint8_t> cells;     ///< the stored cells, zero-padded
+  std::vector<std::uint8_t> setCells;  ///< the cells to classify (every set bit)
   std::vector<std::int32_t> offsets;
 };
 
