@@ -1,6 +1,7 @@
 // Binning of particle keys into encoded bricks (layout in BrickBinning.h).
 // Sorting: an in-place MSD radix sort on the brick Morton code in 16-bit digits (American flag
-// sort: one pass for the grids of practice, whose codes have at most 15 bits), then per brick
+// sort: one pass for the grids of practice, whose codes have at most 15 bits), in a stripe of
+// the keys per task, so a brick's keys are a run in each stripe; then per brick
 // either a cell histogram (dense bricks) or a comparison sort (sparse bricks). In place, because
 // fresh memory is what binning pays most for: on the virtual machines of farms and clouds the
 // first touch of a page costs more than the sort's moves.
@@ -8,8 +9,10 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -245,10 +248,29 @@ void splitByBrick(std::uint64_t* keys, std::size_t begin, std::size_t end, std::
   for (const auto& r : sub) runs.insert(runs.end(), r.begin(), r.end());
 }
 
-/// Encodes one brick's keys (same brick code, any order) into `out` (reuses its vectors); with
-/// `kinds`, a cell's kind is the smallest of its keys' (the key layout of binningKey).
-void decodeRun(std::span<std::uint64_t> keys, const KeyGrid& grid, bool attribute, bool kinds, DecodedBrick& out,
-               std::vector<std::uint32_t>& histogram, std::vector<ParticleKind>& cellKinds) {
+/// Up to this many stripes of the keys are split by brick independently, one task each.
+constexpr std::size_t kMaxStripes = 8;
+/// Keys a stripe holds at least.
+constexpr std::size_t kStripeKeys = std::size_t(1) << 20;
+
+/// The keys of one brick: a run in each stripe that has some.
+struct BrickParts {
+  std::uint64_t code = 0;
+  std::size_t count = 0;
+  std::array<BrickRun, kMaxStripes> runs{};
+  std::size_t keys() const {
+    std::size_t n = 0;
+    for (std::size_t r = 0; r < count; ++r) n += runs[r].end - runs[r].begin;
+    return n;
+  }
+};
+
+/// Encodes one brick's keys (same brick code, any order, in the runs of `parts` of `all`) into
+/// `out` (reuses its vectors); with `kinds`, a cell's kind is the smallest of its keys' (the key
+/// layout of binningKey). `gathered` holds the keys of a sparse brick of several runs.
+void decodeRun(std::uint64_t* all, const BrickParts& parts, const KeyGrid& grid, bool attribute, bool kinds,
+               DecodedBrick& out, std::vector<std::uint32_t>& histogram, std::vector<ParticleKind>& cellKinds,
+               std::vector<std::uint64_t>& gathered) {
   out.cells.clear();
   out.counts.clear();
   out.attributes.clear();
@@ -262,8 +284,19 @@ void decodeRun(std::span<std::uint64_t> keys, const KeyGrid& grid, bool attribut
     const auto narrow = std::uint32_t((key >> 2) & 0x3fff);
     return std::uint16_t((narrow << 2) | (narrow >> 12));  // 14 bits widened: 0 -> 0, 16383 -> 65535
   };
-  if (keys.size() * 16 < cellsPerBrick) {
+  const std::size_t total = parts.keys();
+  auto forEachKey = [&](auto f) {
+    for (std::size_t r = 0; r < parts.count; ++r)
+      for (std::size_t i = parts.runs[r].begin; i != parts.runs[r].end; ++i) f(all[i]);
+  };
+  if (total * 16 < cellsPerBrick) {
     // Sparse: sort (cell, attribute) directly.
+    std::span<std::uint64_t> keys(all + parts.runs[0].begin, parts.runs[0].end - parts.runs[0].begin);
+    if (parts.count > 1) {
+      gathered.clear();
+      forEachKey([&](std::uint64_t k) { gathered.push_back(k); });
+      keys = gathered;
+    }
     std::sort(keys.begin(), keys.end());
     for (std::size_t i = 0; i < keys.size(); ++i) {
       const std::uint32_t cell = cellOf(keys[i]);
@@ -280,10 +313,10 @@ void decodeRun(std::span<std::uint64_t> keys, const KeyGrid& grid, bool attribut
   }
   // Dense: histogram over the brick's cells.
   histogram.assign(cellsPerBrick, 0);
-  for (auto k : keys) ++histogram[cellOf(k)];
+  forEachKey([&](std::uint64_t k) { ++histogram[cellOf(k)]; });
   if (kinds) {
     cellKinds.assign(cellsPerBrick, ParticleKind(kParticleKindCount - 1));
-    for (auto k : keys) cellKinds[cellOf(k)] = std::min(cellKinds[cellOf(k)], kindOf(k));
+    forEachKey([&](std::uint64_t k) { cellKinds[cellOf(k)] = std::min(cellKinds[cellOf(k)], kindOf(k)); });
   }
   std::uint32_t offset = 0;
   for (std::uint32_t c = 0; c < cellsPerBrick; ++c) {
@@ -296,8 +329,8 @@ void decodeRun(std::span<std::uint64_t> keys, const KeyGrid& grid, bool attribut
     offset += count;
   }
   if (!attribute) return;
-  out.attributes.resize(keys.size());
-  for (auto k : keys) out.attributes[histogram[cellOf(k)]++] = attributeOf(k);
+  out.attributes.resize(total);
+  forEachKey([&](std::uint64_t k) { out.attributes[histogram[cellOf(k)]++] = attributeOf(k); });
   std::size_t start = 0;
   for (auto count : out.counts) {
     std::sort(out.attributes.begin() + start, out.attributes.begin() + start + count);
@@ -311,26 +344,47 @@ void binKeys(std::span<std::uint64_t> keys, const KeyGrid& grid, int zstdLevel,
              const std::function<void(EncodedBrick&&)>& sink) {
   if (keys.empty()) return;
   const bool attribute = grid.attribute(), kinds = grid.header.particleKinds;
-  std::vector<BrickRun> runs;
   const std::uint32_t lowBit = 16 + grid.cellBits;
-  splitByBrick(keys.data(), 0, keys.size(), lowBit, lowBit + grid.codeBits, runs);
+  // The in-place split moves keys one at a time: stripes of the keys are split on their own,
+  // in parallel, and a brick's keys are its runs of every stripe (decodeRun does not need them
+  // in one piece, nor in order).
+  const std::size_t stripes = std::clamp<std::size_t>(
+      std::min<std::size_t>(keys.size() / kStripeKeys, std::size_t(tbb::this_task_arena::max_concurrency())), 1,
+      kMaxStripes);
+  std::vector<std::vector<BrickRun>> stripeRuns(stripes);
+  tbb::parallel_for(std::size_t(0), stripes, [&](std::size_t s) {
+    splitByBrick(keys.data(), keys.size() * s / stripes, keys.size() * (s + 1) / stripes, lowBit,
+                 lowBit + grid.codeBits, stripeRuns[s]);
+  });
+  std::vector<BrickParts> bricks;  // ascending codes: a merge of the stripes' ascending runs
+  {
+    std::vector<std::pair<std::uint64_t, BrickRun>> all;
+    for (const auto& runs : stripeRuns)
+      for (const BrickRun& run : runs) all.emplace_back(keys[run.begin] >> lowBit, run);
+    std::stable_sort(all.begin(), all.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (const auto& [code, run] : all) {
+      if (bricks.empty() || bricks.back().code != code) bricks.push_back({code, 0, {}});
+      BrickParts& parts = bricks.back();
+      parts.runs[parts.count++] = run;
+    }
+  }
 
   constexpr std::size_t kBatch = 64;
   std::vector<EncodedBrick> batch;
-  for (std::size_t first = 0; first < runs.size(); first += kBatch) {
-    const std::size_t count = std::min(kBatch, runs.size() - first);
+  for (std::size_t first = 0; first < bricks.size(); first += kBatch) {
+    const std::size_t count = std::min(kBatch, bricks.size() - first);
     batch.assign(count, {});
     tbb::parallel_for(std::size_t(0), count, [&](std::size_t i) {
-      const BrickRun& run = runs[first + i];
-      const std::span<std::uint64_t> span = keys.subspan(run.begin, run.end - run.begin);
+      const BrickParts& parts = bricks[first + i];
       thread_local DecodedBrick brick;
       thread_local std::vector<std::uint32_t> histogram;
       thread_local std::vector<ParticleKind> cellKinds;
-      decodeRun(span, grid, attribute, kinds, brick, histogram, cellKinds);
+      thread_local std::vector<std::uint64_t> gathered;
+      decodeRun(keys.data(), parts, grid, attribute, kinds, brick, histogram, cellKinds, gathered);
       EncodedBrick& e = batch[i];
       for (ParticleKind kind : brick.kinds) ++e.kindCells[std::size_t(kind)];
-      e.coord = glm::uvec3(mortonDecode3(std::uint32_t(span[0] >> lowBit)));
-      e.particles = std::uint32_t(span.size());
+      e.coord = glm::uvec3(mortonDecode3(std::uint32_t(parts.code)));
+      e.particles = std::uint32_t(parts.keys());
       e.cells = std::uint32_t(brick.cells.size());
       e.payload = encodeBrick(brick, zstdLevel);
     });

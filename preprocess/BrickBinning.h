@@ -126,7 +126,7 @@ struct EncodedBrick {
   std::vector<std::byte> payload;
 };
 
-/// Sorts `keys` (binning keys) by brick in place, groups them and encodes each brick, with a
+/// Sorts `keys` (binning keys) by brick in place (in stripes, see BrickBinning.cpp), groups them and encodes each brick, with a
 /// kind per cell when the store has kinds; calls `sink` in ascending Morton order. Memory: keys +
 /// one batch of compressed payloads.
 void binKeys(std::span<std::uint64_t> keys, const KeyGrid& grid, int zstdLevel,
