@@ -36,6 +36,16 @@ KeyGrid::KeyGrid(const StoreHeader& h, std::optional<Box> clipBox)
       codeBits(3 * octreeLevelsFor(std::max({h.brickGrid.x, h.brickGrid.y, h.brickGrid.z}))),
       valueInKey(h.attribute != AttributeKind::None && cellBits + codeBits <= kPackedCellBits) {
   FLIPSCOPE_CHECK(cellBits + codeBits + 16 <= 64, "grid too large for 64-bit keys");
+  const std::uint32_t mask = h.brickSize - 1;
+  for (int a = 0; a < 3; ++a) {
+    axisKeys[a].resize(cells[a]);
+    for (std::uint32_t c = 0; c < cells[a]; ++c) {
+      glm::uvec3 brick(0);
+      brick[a] = c >> brickShift;
+      axisKeys[a][c] = (std::uint64_t(mortonEncode3(brick.x, brick.y, brick.z)) << cellBits) |
+                       (std::uint64_t(c & mask) << (std::uint32_t(a) * brickShift));
+    }
+  }
 }
 
 float attributeValue(const ParticleChunk& chunk, AttributeKind kind, std::size_t i) {
@@ -81,7 +91,7 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& 
   if (separateValues) out.values.resize(base + n);
   std::uint64_t* keys = out.cellKeys.data() + base;
   float* values = separateValues ? out.values.data() + base : nullptr;
-  const std::uint32_t mask = grid.header.brickSize - 1;
+  const std::uint64_t *keysX = grid.axisKeys[0].data(), *keysY = grid.axisKeys[1].data(), *keysZ = grid.axisKeys[2].data();
 
   // Fixed blocks, each compacted in place by its own task; skipped particles close up after.
   struct Tally {
@@ -91,9 +101,15 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& 
   };
   constexpr std::size_t kBlock = 1 << 14;
   std::vector<Tally> tallies((n + kBlock - 1) / kBlock);
+  // Locals, not the grid's members: the compiler need not load them again after each key stored.
+  const glm::dvec3 origin = grid.header.origin, limit(grid.cells);
+  const double inverseCell = grid.invCellSize;
+  const std::optional<Box> clip = grid.clip;
+  const bool valueInKey = grid.valueInKey;
   tbb::parallel_for(std::size_t(0), tallies.size(), [&](std::size_t b) {
-    Tally& t = tallies[b];
+    Tally t;
     const std::size_t begin = b * kBlock, end = std::min(n, begin + kBlock);
+    std::size_t to = begin;
     for (std::size_t i = begin; i != end; ++i) {
       const glm::vec3 p = chunk.positions[i];
       if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
@@ -101,32 +117,30 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& 
         continue;
       }
       const glm::dvec3 q(p);
-      const glm::dvec3 c = fastFloor((q - grid.header.origin) * grid.invCellSize);
-      if ((grid.clip && !grid.clip->contains(q)) || c.x < 0 || c.y < 0 || c.z < 0 ||
-          c.x >= double(grid.cells.x) || c.y >= double(grid.cells.y) || c.z >= double(grid.cells.z)) {
+      const glm::dvec3 c = fastFloor((q - origin) * inverseCell);
+      if ((clip && !clip->contains(q)) || c.x < 0 || c.y < 0 || c.z < 0 || c.x >= limit.x || c.y >= limit.y ||
+          c.z >= limit.z) {
         ++t.outside;
         continue;
       }
       const glm::uvec3 cell(c);
-      const glm::uvec3 brick = cell >> grid.brickShift;
-      const glm::uvec3 local = cell & mask;
-      const std::uint64_t code = mortonEncode3(brick.x, brick.y, brick.z);
-      const std::uint64_t inBrick = local.x | (local.y << grid.brickShift) | (local.z << (2 * grid.brickShift));
-      const std::uint64_t cellKey = (code << grid.cellBits) | inBrick;
+      const std::uint64_t cellKey = keysX[cell.x] | keysY[cell.y] | keysZ[cell.z];
       const std::uint64_t particleKind = types ? std::uint64_t(kindOfTypeValue(types->values[i])) : 0;
       const float s = attribute ? attributeValue(chunk, kind, i) : 0.0f;
       if (attribute && std::isfinite(s)) {
         t.valueMin = std::min(t.valueMin, s);
         t.valueMax = std::max(t.valueMax, s);
       }
-      const std::size_t to = begin + t.kept++;
-      if (grid.valueInKey) {
+      if (valueInKey) {
         keys[to] = (((particleKind << kPackedCellBits) | cellKey) << 32) | std::bit_cast<std::uint32_t>(s);
       } else {
         keys[to] = (particleKind << kKindShift) | cellKey;
         if (values) values[to] = s;
       }
+      ++to;
     }
+    t.kept = to - begin;
+    tallies[b] = t;
   });
 
   KeyTally result;

@@ -46,6 +46,9 @@ struct KeyGrid {
   /// Whether a batch key carries its particle's attribute value (see KeyBatch): the store has an
   /// attribute and a cell key fits kPackedCellBits.
   bool valueInKey;
+  /// Per axis, a cell coordinate's bits of its cell key: the axis' bits of the brick's Morton
+  /// code and of the cell in the brick. A cell key is the OR of its three coordinates' entries.
+  std::array<std::vector<std::uint64_t>, 3> axisKeys;
 
   bool attribute() const { return header.attribute != AttributeKind::None; }
   /// Where a batch key's cell key starts: 32 when valueInKey, else 0.
