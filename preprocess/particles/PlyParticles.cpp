@@ -331,7 +331,16 @@ class PlyReader final : public ParticleSource {
     bool plainFloats = mHeader.encoding == PlyEncoding::BinaryLittleEndian;
     for (int i = 0; i < (mHasVelocity ? 6 : 3); ++i)
       plainFloats = plainFloats && mHeader.vertexProperties[*mFields[i]].type == PlyType::Float32;
-    if (plainFloats) {
+    // Most writers put x, y, z (and vx, vy, vz) side by side: one 12-byte copy each.
+    const bool sideBySide = offsets[1] == offsets[0] + 4 && offsets[2] == offsets[0] + 8 &&
+                            (!mHasVelocity || (offsets[4] == offsets[3] + 4 && offsets[5] == offsets[3] + 8));
+    if (plainFloats && sideBySide) {
+      const std::byte* record = mBuffer.data();
+      for (std::uint64_t k = 0; k < n; ++k, record += stride) {
+        std::memcpy(&chunk.positions[k], record + offsets[0], sizeof(glm::vec3));
+        if (mHasVelocity) std::memcpy(&chunk.velocities[k], record + offsets[3], sizeof(glm::vec3));
+      }
+    } else if (plainFloats) {
       for (std::uint64_t k = 0; k < n; ++k) {
         const std::byte* record = mBuffer.data() + k * stride;
         for (int c = 0; c < 3; ++c) std::memcpy(&chunk.positions[k][c], record + offsets[c], 4);
