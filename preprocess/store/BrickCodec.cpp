@@ -158,22 +158,21 @@ DecodedBrick decodeBrick(std::span<const std::byte> payload, const std::filesyst
     throw fail("holds " + std::to_string(occupied) + " cells, table says " + std::to_string(expected.cells));
   brick.cells.resize(occupied);
   brick.counts.resize(occupied);
-  std::uint64_t cell = 0;
-  for (std::uint64_t i = 0; i < occupied; ++i) {
-    const std::uint64_t gap = in.getVarint("cell gap");
+  std::uint64_t cell = ~std::uint64_t(0);  // the first gap counts from -1
+  std::uint32_t* cells = brick.cells.data();
+  in.forEachVarint(occupied, "cell gap", [&](std::uint64_t gap) {
     if (gap >= cellsPerBrick) throw fail("cell gap " + std::to_string(gap) + " is larger than the brick");
-    cell = i == 0 ? gap : cell + 1 + gap;  // no wrap-around: both terms are below cellsPerBrick
+    cell += 1 + gap;  // no wrap-around past -1: both terms are below cellsPerBrick
     if (cell >= cellsPerBrick) throw fail("cell index " + std::to_string(cell) + " outside the brick");
-    brick.cells[i] = std::uint32_t(cell);
-  }
+    *cells++ = std::uint32_t(cell);
+  });
   std::uint64_t particles = 0;
-  for (std::uint64_t i = 0; i < occupied; ++i) {
-    const std::uint64_t countMinus1 = in.getVarint("cell count");
+  std::uint32_t* counts = brick.counts.data();
+  in.forEachVarint(occupied, "cell count", [&](std::uint64_t countMinus1) {
     if (countMinus1 >= expected.particles) throw fail("cell count larger than the brick's particle count");
-    const std::uint64_t count = countMinus1 + 1;
-    brick.counts[i] = std::uint32_t(count);
-    particles += count;
-  }
+    *counts++ = std::uint32_t(countMinus1 + 1);
+    particles += countMinus1 + 1;
+  });
   if (particles != expected.particles)
     throw fail("holds " + std::to_string(particles) + " particles, table says " + std::to_string(expected.particles));
   if (hasKinds) {
