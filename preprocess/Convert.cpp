@@ -90,7 +90,11 @@ class SpillBuckets {
  public:
   SpillBuckets(const std::filesystem::path& dir, const std::string& prefix, std::uint32_t shift, std::uint32_t bits,
                bool values, std::size_t bufferBytes)
-      : mShift(shift), mBits(bits), mValues(values), mBufferBytes(bufferBytes), mAppender(bufferBytes, kQueuedBlocks) {
+      : mShift(shift),
+        mBits(bits),
+        mValues(values),
+        mBufferBytes(bufferBytes),
+        mAppender(std::make_unique<detail::BackgroundAppender>(bufferBytes, kQueuedBlocks)) {
     const std::size_t count = std::size_t(1) << bits;
     for (std::size_t b = 0; b < count; ++b) {
       Bucket bucket;
@@ -99,6 +103,7 @@ class SpillBuckets {
     }
   }
   ~SpillBuckets() {
+    mAppender.reset();  // first: its queued writes name the files
     for (auto& b : mBuckets) {
       b.file.reset();
       std::error_code ec;
@@ -114,7 +119,7 @@ class SpillBuckets {
     const std::size_t bytes = recordBytes(mValues);
     for (std::size_t i = 0; i < n; ++i) {
       Bucket& b = mBuckets[(keys[i] >> mShift) & mask];
-      if (b.buffer.size() == 0) b.buffer = mAppender.take();
+      if (b.buffer.size() == 0) b.buffer = mAppender->take();
       std::byte* record = b.buffer.data() + b.used;
       std::memcpy(record, &keys[i], 8);
       if (mValues) std::memcpy(record + 8, &values[i], 4);
@@ -125,7 +130,7 @@ class SpillBuckets {
   }
   void finish() {
     for (auto& b : mBuckets) flush(b, true);
-    mAppender.drain();
+    mAppender->drain();
     for (auto& b : mBuckets) b.file.reset();
   }
   std::size_t size() const { return mBuckets.size(); }
@@ -219,10 +224,10 @@ class SpillBuckets {
     detail::AlignedBuffer rest;
     const std::size_t left = last ? 0 : b.used - whole;
     if (!last) {
-      rest = mAppender.take();
+      rest = mAppender->take();
       std::memcpy(rest.data(), b.buffer.data() + whole, left);
     }
-    mAppender.append(*b.file, std::move(b.buffer), whole);
+    mAppender->append(*b.file, std::move(b.buffer), whole);
     b.buffer = std::move(rest);
     b.used = left;
     stopPoint("spill");
@@ -235,7 +240,7 @@ class SpillBuckets {
   bool mValues;
   std::size_t mBufferBytes;
   std::vector<Bucket> mBuckets;
-  detail::BackgroundAppender mAppender;  ///< after mBuckets: destroyed first, its writes done before the files close
+  std::unique_ptr<detail::BackgroundAppender> mAppender;
 };
 
 /// Bins one frame's keys: in memory while they fit, spilled to buckets beyond.

@@ -137,10 +137,11 @@ TEST_P(ConvertOracle, StoreMatchesBruteForceBinning) {
 }
 
 // With an attribute, 64 and 0.02 (600 cells) make 30-bit cell keys, which carry their values
-// (KeyGrid::valueInKey), and 128 and 0.01 (1200 cells) 33-bit ones, which do not.
+// (KeyGrid::valueInKey), and 128 and 0.01 (1200 cells) 33-bit ones, which do not. 32 and 0.004
+// (94 bricks an axis) make 21-bit brick codes: the split by brick takes two digits.
 INSTANTIATE_TEST_SUITE_P(BrickSizes, ConvertOracle,
                          ::testing::Values(Case{32, 0.05, false}, Case{64, 0.02, true}, Case{128, 0.01, true},
-                                           Case{32, 0.5, true}));
+                                           Case{32, 0.5, true}, Case{32, 0.004, true}));
 
 // The 16-bit attribute code, against values worked out by hand (the oracle above shares the
 // converter's quantizeAttribute, so it cannot catch a rounding or range bug).

@@ -55,5 +55,51 @@ TEST(DirectFile, AFileThatCannotBeCreatedOrOpenedIsNamed) {
   EXPECT_THROW(DirectFile(path, DirectFile::Mode::Read), FileError);
 }
 
+TEST(BackgroundAppender, WritesEachFilesBlocksInOrderWhileTheCallerGoesOn) {
+  // Two files, blocks queued to them in turn through buffers taken from the appender; each file
+  // holds its blocks in the order queued once drained.
+  testing::TempDir dir("background-appender");
+  constexpr int kBlocks = 40;
+  {
+    DirectFile a(dir / "a", DirectFile::Mode::Create), b(dir / "b", DirectFile::Mode::Create);
+    detail::BackgroundAppender appender(kDirectBlock, 3);
+    for (int i = 0; i < kBlocks; ++i) {
+      for (DirectFile* file : {&a, &b}) {
+        AlignedBuffer block = appender.take();
+        ASSERT_EQ(block.size(), kDirectBlock);
+        std::memset(block.data(), file == &a ? i : 100 + i, block.size());
+        appender.append(*file, std::move(block), kDirectBlock);
+      }
+    }
+    appender.drain();
+  }
+  for (const char* name : {"a", "b"}) {
+    DirectFile file(dir / name, DirectFile::Mode::Read);
+    AlignedBuffer block(kDirectBlock);
+    for (int i = 0; i < kBlocks; ++i) {
+      ASSERT_EQ(file.read({block.data(), block.size()}), kDirectBlock) << name << " block " << i;
+      EXPECT_EQ(block.data()[kDirectBlock - 1], std::byte(name[0] == 'a' ? i : 100 + i)) << name << " block " << i;
+    }
+    EXPECT_EQ(file.read({block.data(), block.size()}), 0u) << name;
+  }
+}
+
+TEST(BackgroundAppender, AWriteErrorComesBackFromTheNextCall) {
+  testing::TempDir dir("background-appender-error");
+  { DirectFile(dir / "readonly", DirectFile::Mode::Create); }
+  DirectFile readOnly(dir / "readonly", DirectFile::Mode::Read);  // writes to it fail
+  detail::BackgroundAppender appender(kDirectBlock, 2);
+  AlignedBuffer block = appender.take();
+  std::memset(block.data(), 0, block.size());
+  appender.append(readOnly, std::move(block), kDirectBlock);
+  try {
+    appender.drain();
+    FAIL() << "the failed write was not reported";
+  } catch (const FileError& e) {
+    EXPECT_NE(std::string(e.what()).find("readonly"), std::string::npos) << e.what();
+  }
+  appender.drain();  // reported once
+}
+
 }  // namespace
 }  // namespace flipscope
