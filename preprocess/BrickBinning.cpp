@@ -75,7 +75,8 @@ ParticleKind kindOfTypeValue(float flags) {
 KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& out, const AttributeColumn* types) {
   const std::size_t n = chunk.size();
   const AttributeKind kind = grid.header.attribute;
-  FLIPSCOPE_CHECK(!types || (types->arity == 1 && types->values.size() == n), "a type column needs one value a particle");
+  FLIPSCOPE_CHECK(!types || (types->arity == 1 && types->values.size() == n),
+                  "a type column needs one value a particle");
   FLIPSCOPE_CHECK(kind != AttributeKind::Speed || chunk.velocities.size() == n, "speed needs velocities");
   FLIPSCOPE_CHECK(kind != AttributeKind::Scalar || (!chunk.attributes.empty() && chunk.attributes.front().arity == 1 &&
                                                     chunk.attributes.front().values.size() == n),
@@ -91,7 +92,8 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& 
   if (separateValues) out.values.resize(base + n);
   std::uint64_t* keys = out.cellKeys.data() + base;
   float* values = separateValues ? out.values.data() + base : nullptr;
-  const std::uint64_t *keysX = grid.axisKeys[0].data(), *keysY = grid.axisKeys[1].data(), *keysZ = grid.axisKeys[2].data();
+  const std::uint64_t *keysX = grid.axisKeys[0].data(), *keysY = grid.axisKeys[1].data(),
+                      *keysZ = grid.axisKeys[2].data();
 
   // Fixed blocks, each compacted in place by its own task; skipped particles close up after.
   struct Tally {
@@ -207,8 +209,8 @@ struct BrickRun {
 /// Sorts keys[begin,end) in place by the bits [lowBit, highBit) (the brick code), most
 /// significant digit first (American flag sort: a histogram, then each key swapped into its
 /// digit's range); appends one run per distinct code in ascending code order.
-void splitByBrick(std::uint64_t* keys, std::size_t begin, std::size_t end, std::uint32_t lowBit,
-                  std::uint32_t highBit, std::vector<BrickRun>& runs) {
+void splitByBrick(std::uint64_t* keys, std::size_t begin, std::size_t end, std::uint32_t lowBit, std::uint32_t highBit,
+                  std::vector<BrickRun>& runs) {
   if (begin == end) return;
   if (highBit <= lowBit) {
     runs.push_back({begin, end});

@@ -9,8 +9,8 @@
 // known only after the whole frame was read.
 //
 // Stores with particle kinds: the cell key carries the particle's kind (through the spill files,
-// which look at the brick code only), and the
-// full key is [ brick ][ cell ][ attribute : 14 bits ][ kind : 2 bits ] (binningKey). Of the
+// which look at the brick code only), and the full key is
+// [ brick ][ cell ][ attribute : 14 bits ][ kind : 2 bits ] (binningKey). Of the
 // layouts that fit 64 bits this is the simplest and fastest: nothing travels beside the keys,
 // attributes stay ascending within a cell (DecodedBrick), and a cell's kind, the smallest of its
 // particles', is taken on the pass that groups the cell's keys anyway. The price: attributes of
@@ -129,9 +129,9 @@ struct EncodedBrick {
   std::vector<std::byte> payload;
 };
 
-/// Sorts `keys` (binning keys) by brick in place (in stripes, see BrickBinning.cpp), groups them and encodes each brick, with a
-/// kind per cell when the store has kinds; calls `sink` in ascending Morton order. Memory: keys +
-/// one batch of compressed payloads.
+/// Sorts `keys` (binning keys) by brick in place (in stripes, see BrickBinning.cpp), groups them
+/// and encodes each brick, with a kind per cell when the store has kinds; calls `sink` in
+/// ascending Morton order. Memory: keys + one batch of compressed payloads.
 void binKeys(std::span<std::uint64_t> keys, const KeyGrid& grid, int zstdLevel,
              const std::function<void(EncodedBrick&&)>& sink);
 

@@ -23,10 +23,10 @@
 #include "preprocess/BrickBinning.h"
 #include "preprocess/DirectFile.h"
 #include "preprocess/FiniteBounds.h"
-#include "preprocess/store/FrameFile.h"
-#include "preprocess/store/StoreLock.h"
 #include "preprocess/ParticleSpacing.h"
 #include "preprocess/particles/PrefetchingSource.h"
+#include "preprocess/store/FrameFile.h"
+#include "preprocess/store/StoreLock.h"
 
 namespace flipscope {
 namespace {
@@ -70,13 +70,14 @@ struct MemoryPlan {
     maxBinParticles = std::max<std::uint64_t>(budget * 6 / 10 / perParticle, 1 << 16);
     // An eighth of the budget buffers the spill files: up to 256 of up to 1 MiB (direct writes of
     // 64 KiB ran at half the disk's speed of 1 MiB ones here).
-    spillBufferBytes = std::clamp<std::uint64_t>(budget / 8 / 256 / detail::kDirectBlock, 16, 256) * detail::kDirectBlock;
+    spillBufferBytes =
+        std::clamp<std::uint64_t>(budget / 8 / 256 / detail::kDirectBlock, 16, 256) * detail::kDirectBlock;
     maxBucketFiles = std::clamp<std::uint64_t>(budget / 8 / spillBufferBytes, 2, 256);
   }
   std::uint64_t chunkParticles;   ///< particles read at once
   std::uint64_t maxBinParticles;  ///< particles binned in memory at once
   std::uint64_t maxBucketFiles;   ///< spill files open at once
-  std::uint64_t spillBufferBytes; ///< buffer of each, a multiple of kDirectBlock
+  std::uint64_t spillBufferBytes;  ///< buffer of each, a multiple of kDirectBlock
 };
 
 /// Spill record: the batch key (KeyBatch), then the attribute value when it travels beside it.
@@ -356,7 +357,7 @@ class FrameBinner {
 
   const KeyGrid& mGrid;
   bool mSpillFromStart;  ///< the source's count says the frame will not fit in memory
-  bool mValues;  ///< attribute values travel beside the keys (not KeyGrid::valueInKey)
+  bool mValues;          ///< attribute values travel beside the keys (not KeyGrid::valueInKey)
   MemoryPlan mPlan;
   const ConvertOptions& mOptions;
   std::filesystem::path mScratch;

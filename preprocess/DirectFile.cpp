@@ -4,10 +4,10 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
-#include <algorithm>
 #include <new>
 #include <string>
 
@@ -29,8 +29,9 @@ DirectFile::DirectFile(const std::filesystem::path& path, Mode mode) : mPath(pat
   mFd = ::open(path.c_str(), flags | O_DIRECT, 0644);
   if (mFd < 0 && errno == EINVAL) mFd = ::open(path.c_str(), flags, 0644);  // tmpfs and others: no O_DIRECT
   if (mFd < 0)
-    throw FileError(path, std::string(mode == Mode::Create ? "cannot create spill file: " : "cannot reopen spill file: ") +
-                              std::strerror(errno));
+    throw FileError(path,
+                    std::string(mode == Mode::Create ? "cannot create spill file: " : "cannot reopen spill file: ") +
+                        std::strerror(errno));
 }
 
 DirectFile::~DirectFile() {
@@ -41,7 +42,8 @@ void DirectFile::append(std::span<const std::byte> bytes) {
   while (!bytes.empty()) {
     const ssize_t n = ::write(mFd, bytes.data(), bytes.size());
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) throw FileError(mPath, std::string("spill write failed (disk full?): ") + std::strerror(n < 0 ? errno : ENOSPC));
+    if (n <= 0)
+      throw FileError(mPath, std::string("spill write failed (disk full?): ") + std::strerror(n < 0 ? errno : ENOSPC));
     bytes = bytes.subspan(std::size_t(n));
   }
 }

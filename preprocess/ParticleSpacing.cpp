@@ -299,7 +299,8 @@ class KthNeighbours {
         for (int y = first.y; y <= last.y; ++y) {
           const double yz = distance[2][std::size_t(z - first.z)] + distance[1][std::size_t(y - first.y)];
           if (yz > reach2) continue;
-          const std::size_t row = (std::size_t(z) * std::size_t(mNearQueryDims.y) + std::size_t(y)) * std::size_t(mNearQueryDims.x);
+          const std::size_t row =
+              (std::size_t(z) * std::size_t(mNearQueryDims.y) + std::size_t(y)) * std::size_t(mNearQueryDims.x);
           for (int x = first.x; x <= last.x; ++x) {
             if (yz + distance[0][std::size_t(x - first.x)] > reach2) continue;
             const std::size_t bit = row + std::size_t(x);
@@ -315,7 +316,8 @@ class KthNeighbours {
     const glm::dvec3 g = (p - mLo) * mNearQueryInverse;  // >= 0: p is inside
     const glm::ivec3 c = glm::min(glm::ivec3(g), mNearQueryDims - 1);
     const std::size_t bit =
-        (std::size_t(c.z) * std::size_t(mNearQueryDims.y) + std::size_t(c.y)) * std::size_t(mNearQueryDims.x) + std::size_t(c.x);
+        (std::size_t(c.z) * std::size_t(mNearQueryDims.y) + std::size_t(c.y)) * std::size_t(mNearQueryDims.x) +
+        std::size_t(c.x);
     return mNearQueryBits[bit / 64] >> (bit % 64) & 1;
   }
 

@@ -113,7 +113,8 @@ void classifyBrickFoam(const glm::uvec4* subBricks, glm::uvec4* foam, const Foam
   for (int z = 0; z < extent.z; ++z)
     for (int y = 0; y < extent.y; ++y)
       for (int x = 0; x < int(setRow); x += kLanes) {
-        const std::uint64_t set = load8(&scratch.setCells[std::size_t(x) + setRow * std::size_t(y) + setPlane * std::size_t(z)]);
+        const std::uint64_t set =
+            load8(&scratch.setCells[std::size_t(x) + setRow * std::size_t(y) + setPlane * std::size_t(z)]);
         if (set == 0) continue;
         const std::uint8_t* centre = cells + at(x, y, z);
         std::uint64_t short_ = 0;  // the lowest bit of each byte whose cell has fewer than enough: foam

@@ -4,9 +4,9 @@
 
 #include <cstring>
 
+#include "TestSupport.h"
 #include "core/Error.h"
 #include "preprocess/DirectFile.h"
-#include "TestSupport.h"
 
 namespace flipscope {
 namespace {

@@ -110,8 +110,8 @@ TEST(ParticleSpacing, TheSearchFindsTheKthNeighboursOfComparingEveryPair) {
     ASSERT_EQ(found.size(), queries.size());
     std::size_t within = 0;
     for (std::size_t q = 0; q < queries.size(); ++q) {
-      const double expected = double(kth2[q]) <= radius * radius ? std::sqrt(double(kth2[q]))
-                                                                  : std::numeric_limits<double>::infinity();
+      const double expected =
+          double(kth2[q]) <= radius * radius ? std::sqrt(double(kth2[q])) : std::numeric_limits<double>::infinity();
       within += std::isfinite(expected);
       ASSERT_EQ(found[q], expected) << "query " << q << " at radius " << radius;
     }

@@ -41,9 +41,11 @@ TEST_P(ConvertMemory, PeakStaysWithinTheBudgetPlusTheFixedOverhead) {
   const std::string velocity = GetParam() == "bin" ? "" : " --velocity";  // raw files hold positions only
   const auto synth = testing::runFlipscope("synth -o " + input + " --particles 5M" + velocity, dir.path());
   ASSERT_EQ(synth.exitCode, 0) << synth.output;
-  const auto run = testing::runFlipscope("convert " + input + " -o store --mem " + std::to_string(kBudgetMiB) + "M", dir.path());
+  const auto run =
+      testing::runFlipscope("convert " + input + " -o store --mem " + std::to_string(kBudgetMiB) + "M", dir.path());
   ASSERT_EQ(run.exitCode, 0) << run.output;
-  EXPECT_NE(run.output.find("(out of core)"), std::string::npos) << "5 M particles should not fit the budget: " << run.output;
+  EXPECT_NE(run.output.find("(out of core)"), std::string::npos)
+      << "5 M particles should not fit the budget: " << run.output;
   const double peak = peakMiB(run.output);
   ASSERT_GT(peak, 0) << run.output;
   if (kSanitized) GTEST_SKIP() << "sanitizer build: peak " << peak << " MiB not compared";
