@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <future>
 #include <memory>
 
 #include <tbb/blocked_range.h>
@@ -317,14 +318,39 @@ class FrameBinner {
 
   void binBuckets(const SpillBuckets& buckets, FrameWriter& writer) {
     std::uint64_t largest = 0;  // of the buckets binned in memory: reserved once, no reallocation copies
-    for (std::size_t b = 0; b < buckets.size(); ++b)
+    bool skewed = false;        // some bucket must be split again
+    for (std::size_t b = 0; b < buckets.size(); ++b) {
       if (buckets.records(b) <= mPlan.maxBinParticles) largest = std::max(largest, buckets.records(b));
-    mKeys.cellKeys.reserve(largest);
-    if (mValues) mKeys.values.reserve(largest);
+      skewed = skewed || buckets.records(b) > mPlan.maxBinParticles;
+    }
+    // The next bucket is read while this one is binned, when two of the largest fit one bin of the
+    // budget and no bucket is split again (its bins would use both batches).
+    const bool ahead = mOptions.readAhead && !skewed && 2 * largest <= mPlan.maxBinParticles;
+    for (KeyBatch* batch : {&mKeys, &mNextKeys}) {
+      if (batch == &mNextKeys && !ahead) break;
+      batch->cellKeys.reserve(largest);
+      if (mValues) batch->values.reserve(largest);
+    }
+    std::future<void> reading;                // of bucket `readBucket` into mNextKeys
+    std::size_t readBucket = buckets.size();  // none
     for (std::size_t b = 0; b < buckets.size(); ++b) {
       if (buckets.records(b) == 0) continue;
       if (buckets.records(b) <= mPlan.maxBinParticles) {
-        buckets.load(b, mKeys);
+        if (readBucket == b) {
+          reading.get();
+          std::swap(mKeys, mNextKeys);
+        } else {
+          buckets.load(b, mKeys);
+        }
+        readBucket = buckets.size();
+        if (ahead) {
+          std::size_t next = b + 1;
+          while (next < buckets.size() && buckets.records(next) == 0) ++next;
+          if (next < buckets.size()) {
+            readBucket = next;
+            reading = std::async(std::launch::async, [&buckets, this, next] { buckets.load(next, mNextKeys); });
+          }
+        }
         binInMemory(mKeys, writer);
         continue;
       }
@@ -364,8 +390,9 @@ class FrameBinner {
   std::string mPrefix;
   FrameStats mStats;
   bool mHasRange = false;
-  KeyBatch mKeys;   // in memory until spilling starts; then each bucket in turn
-  KeyBatch mBatch;  // one chunk, once spilling
+  KeyBatch mKeys;      // in memory until spilling starts; then each bucket in turn
+  KeyBatch mNextKeys;  // the bucket after, read while mKeys is binned
+  KeyBatch mBatch;     // one chunk, once spilling
   std::unique_ptr<SpillBuckets> mSpill;
   std::uint32_t mSpillBuckets = 0;
 };

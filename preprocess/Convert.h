@@ -99,8 +99,9 @@ struct ConvertOptions {
   std::optional<UpAxis> upAxis;
   int zstdLevel = 1;
   /// Read the next chunk of particles on a thread of its own while this one is binned (and
-  /// while the bounds and the spacing passes work on it): PrefetchingSource. Off: one thread
-  /// reads and bins in turn. The store is the same either way.
+  /// while the bounds and the spacing passes work on it): PrefetchingSource; out of core, also
+  /// the next spill bucket while this one is binned. Off: one thread reads and bins in turn.
+  /// The store is the same either way.
   bool readAhead = true;
   std::filesystem::path scratchDir;    ///< spill files; default: the store directory
   /// Add to the store at storeDir, which must exist, with its header: also a store with no

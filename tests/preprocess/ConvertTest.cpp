@@ -207,6 +207,11 @@ TEST_P(ConvertOutOfCore, StoreIsByteIdenticalToInCoreWithAndWithoutReadAhead) {
     EXPECT_EQ(report.spillBuckets > 0, budget < (1ull << 30)) << name;
     EXPECT_EQ(readFile(dir / "frame_000001.fsf"), readFile(inCore / "frame_000001.fsf")) << name;
   }
+  // Under 16 MiB the buckets are small against a bin: the next one is read while this one is
+  // binned (FrameBinner::binBuckets). Under 4 MiB they are not, and are read in turn.
+  const auto [aheadDir, aheadReport] = run(16ull << 20, "ooc-read-ahead");
+  EXPECT_GT(aheadReport.spillBuckets, 1u);
+  EXPECT_EQ(readFile(aheadDir / "frame_000001.fsf"), readFile(inCore / "frame_000001.fsf"));
   // A source that gives its count spills from its first chunk; one that does not is binned in
   // memory until it overflows, then spills what it holds.
   const auto [unhinted, unhintedReport] = run(4ull << 20, "ooc-no-count", true, false);
