@@ -86,7 +86,7 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& 
                        chunk.attributes.front().values.size() == n * std::size_t(chunk.attributes.front().arity)),
                   "a vector attribute needs its column");
   const bool attribute = grid.attribute();
-  const bool separateValues = attribute && !grid.valueInKey;
+  const bool separateValues = grid.valuesBesideKeys();
   const std::size_t base = out.cellKeys.size();
   out.cellKeys.resize(base + n);
   if (separateValues) out.values.resize(base + n);

@@ -51,6 +51,8 @@ struct KeyGrid {
   std::array<std::vector<std::uint64_t>, 3> axisKeys;
 
   bool attribute() const { return header.attribute != AttributeKind::None; }
+  /// Whether a batch's attribute values travel beside its keys (KeyBatch::values).
+  bool valuesBesideKeys() const { return attribute() && !valueInKey; }
   /// Where a batch key's cell key starts: 32 when valueInKey, else 0.
   std::uint32_t cellKeyShift() const { return valueInKey ? 32 : 0; }
 };

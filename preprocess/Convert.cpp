@@ -253,7 +253,7 @@ class FrameBinner {
               std::filesystem::path scratchDir, int frame, std::optional<std::uint64_t> expectedParticles)
       : mGrid(grid),
         mSpillFromStart(expectedParticles && *expectedParticles > plan.maxBinParticles),
-        mValues(grid.attribute() && !grid.valueInKey),
+        mValues(grid.valuesBesideKeys()),
         mPlan(plan),
         mOptions(options),
         mScratch(std::move(scratchDir)),
@@ -326,10 +326,11 @@ class FrameBinner {
     // The next bucket is read while this one is binned, when two of the largest fit one bin of the
     // budget and no bucket is split again (its bins would use both batches).
     const bool ahead = mOptions.readAhead && !skewed && 2 * largest <= mPlan.maxBinParticles;
-    for (KeyBatch* batch : {&mKeys, &mNextKeys}) {
-      if (batch == &mNextKeys && !ahead) break;
-      batch->cellKeys.reserve(largest);
-      if (mValues) batch->values.reserve(largest);
+    mKeys.cellKeys.reserve(largest);
+    if (mValues) mKeys.values.reserve(largest);
+    if (ahead) {
+      mNextKeys.cellKeys.reserve(largest);
+      if (mValues) mNextKeys.values.reserve(largest);
     }
     std::future<void> reading;                // of bucket `readBucket` into mNextKeys
     std::size_t readBucket = buckets.size();  // none
@@ -383,7 +384,7 @@ class FrameBinner {
 
   const KeyGrid& mGrid;
   bool mSpillFromStart;  ///< the source's count says the frame will not fit in memory
-  bool mValues;          ///< attribute values travel beside the keys (not KeyGrid::valueInKey)
+  bool mValues;          ///< KeyGrid::valuesBesideKeys()
   MemoryPlan mPlan;
   const ConvertOptions& mOptions;
   std::filesystem::path mScratch;
@@ -845,11 +846,10 @@ FrameReport convertOneFrame(ParticleSource& source, BrickStore& store, int frame
   const auto start = std::chrono::steady_clock::now();
   const StoreHeader& header = store.header();
   const AttributeKind kind = header.attribute;
-  const bool attribute = kind != AttributeKind::None;
   if (kind == AttributeKind::Speed && !source.hasVelocity())
     throw FileError(source.name(), "has no velocities, but the store keeps a speed attribute");
   const KeyGrid grid(header, options.domain);
-  const MemoryPlan plan(options.memoryBudget, attribute && !grid.valueInKey);
+  const MemoryPlan plan(options.memoryBudget, grid.valuesBesideKeys());
   const std::filesystem::path scratch = options.scratchDir.empty() ? store.directory() : options.scratchDir;
 
   FrameBinner binner(grid, plan, options, scratch, frame, source.countHint());

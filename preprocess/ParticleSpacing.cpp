@@ -274,7 +274,6 @@ class KthNeighbours {
       dims = cellsFor(cell);
     }
     if (!(dims.x * dims.y * dims.z <= kNearQueryCells)) return;  // (extents beyond doubles' reach: no bits)
-    mNearQueryCell = cell;
     mNearQueryInverse = 1 / cell;
     mNearQueryDims = glm::ivec3(dims);
     mNearQueryBits.assign((std::size_t(dims.x * dims.y * dims.z) + 63) / 64, 0);
@@ -419,7 +418,7 @@ class KthNeighbours {
   std::vector<std::uint8_t> mBlockMask;    ///< small grids: see buildTable()
   std::vector<std::uint64_t> mNearBits;    ///< larger grids: see buildTable()
   std::vector<Slot> mTable;                ///< else: the cells with queries, hashed
-  double mNearQueryCell = 0, mNearQueryInverse = 0;  ///< see buildNearQueryBits()
+  double mNearQueryInverse = 0;  ///< see buildNearQueryBits()
   glm::ivec3 mNearQueryDims{0};
   std::vector<std::uint64_t> mNearQueryBits;
   std::size_t mMask = 0;
