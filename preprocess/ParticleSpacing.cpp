@@ -418,7 +418,7 @@ class KthNeighbours {
   std::vector<std::uint8_t> mBlockMask;    ///< small grids: see buildTable()
   std::vector<std::uint64_t> mNearBits;    ///< larger grids: see buildTable()
   std::vector<Slot> mTable;                ///< else: the cells with queries, hashed
-  double mNearQueryInverse = 0;  ///< see buildNearQueryBits()
+  double mNearQueryInverse = 0;            ///< see buildNearQueryBits()
   glm::ivec3 mNearQueryDims{0};
   std::vector<std::uint64_t> mNearQueryBits;
   std::size_t mMask = 0;
