@@ -22,8 +22,9 @@
 // not found within kSpacingMaxPasses reads of the source.
 // Cost of the neighbour estimate: one read of the source when it has at most kSpacingSample
 // particles, else two (rarely more); memory O(kSpacingSample) plus one chunk of particles, plus
-// at most 80 MiB for the cell index of the sample (16 MiB) and its mask of the cells near it
-// (64 MiB), which frames of a few billion particles reach. The source is rewound afterwards.
+// at most about 40 MiB, whatever the frame's size, for the search's cells near the sample: 4 MiB
+// of bits and, per cell within the search radius of a sampled particle (at most 216 each), the
+// list of those particles. The source is rewound afterwards.
 #pragma once
 
 #include <cstddef>
@@ -68,9 +69,11 @@ SpacingEstimate neighbourSpacing(std::span<const glm::vec3> points, std::size_t 
 namespace detail {
 /// The search under the neighbour estimate: for each query, the distance to its
 /// kSpacingNeighbour-th nearest candidate, +inf where that lies beyond `radius`. Candidate i
-/// has id i; a candidate with a query's id is that query itself and does not count.
+/// has id i; a candidate with a query's id is that query itself and does not count. The search
+/// indexes the queries in cells of half the radius (`fineCells`: a frame's pass) or of the
+/// radius (the sample against itself); the result is the same.
 std::vector<double> kthNeighbourDistances(std::span<const glm::vec3> queries, std::span<const std::uint64_t> queryIds,
-                                          std::span<const glm::vec3> candidates, double radius);
+                                          std::span<const glm::vec3> candidates, double radius, bool fineCells);
 }  // namespace detail
 
 }  // namespace flipscope
