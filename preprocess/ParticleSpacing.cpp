@@ -120,7 +120,10 @@ class KthNeighbours {
   /// sample): fewer pass the bits and the lists are shorter. Else cells of the radius, for few
   /// (the sample against itself): the lists are built about four times faster.
   KthNeighbours(const Sample& queries, double radius, bool fine)
-      : mQueries(queries), mRadius(radius), mCell(fine ? radius / 2 : radius), mHeaps(queries.positions.size() * kNeighbours, kInf) {
+      : mQueries(queries),
+        mRadius(radius),
+        mCell(fine ? radius / 2 : radius),
+        mHeaps(queries.positions.size() * kNeighbours, kInf) {
     glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
     for (const glm::vec3& q : queries.positions) {
       lo = glm::min(lo, glm::dvec3(q));
@@ -300,12 +303,12 @@ class KthNeighbours {
   glm::dvec3 mLo{0}, mHi{0};  ///< the queries' bounds grown by the radius
   bool mUsable = false;
   double mCell = 0, mInverseCell = 0;
-  glm::ivec3 mDims{0};                     ///< of the cells over [mLo, mHi]
-  std::vector<std::uint64_t> mBits;        ///< a bit per cell (x fastest): its list is not empty
-  std::vector<std::uint32_t> mWordRank;    ///< per word of mBits, the set bits before it
-  std::vector<std::uint32_t> mListStart;   ///< per set bit, its list's first entry in mListed; then the end
-  std::vector<std::uint32_t> mListed;      ///< the queries of each list
-  std::vector<double> mAxisDistance2[3];   ///< forEachCellNear's scratch
+  glm::ivec3 mDims{0};                    ///< of the cells over [mLo, mHi]
+  std::vector<std::uint64_t> mBits;       ///< a bit per cell (x fastest): its list is not empty
+  std::vector<std::uint32_t> mWordRank;   ///< per word of mBits, the set bits before it
+  std::vector<std::uint32_t> mListStart;  ///< per set bit, its list's first entry in mListed; then the end
+  std::vector<std::uint32_t> mListed;     ///< the queries of each list
+  std::vector<double> mAxisDistance2[3];  ///< forEachCellNear's scratch
   std::vector<float> mHeaps;  ///< k squared distances per query, a max-heap each
   tbb::enumerable_thread_specific<std::vector<Hit>> mHits;
 };
