@@ -58,8 +58,9 @@ inline vec2 floor(vec2 v) { return vec2(floor(v.x), floor(v.y)); }
 inline vec3 floor(vec3 v) { return vec3(floor(v.x), floor(v.y), floor(v.z)); }
 inline vec4 floor(vec4 v) { return vec4(floor(v.x), floor(v.y), floor(v.z), floor(v.w)); }
 
-/// GLSL's bitCount. Without the POPCNT instruction (x86-64's baseline) std::popcount is a call
-/// into libgcc; the same bit trick inline is about twice as fast.
+/// GLSL's bitCount. Without the POPCNT instruction (x86-64's baseline; the default build has it,
+/// CMakeLists.txt) std::popcount is a call into libgcc; the same bit trick inline is about twice
+/// as fast.
 inline int bitCount(uint v) {
 #if defined(__POPCNT__) || !defined(__x86_64__)
   return std::popcount(v);
