@@ -59,7 +59,8 @@ FiniteBounds rangeBounds(const glm::vec3* p, std::size_t n) {
   FiniteBounds t;
   t.finite = finite;
   if (finite)
-    t.bounds = Box{glm::dvec3(scalarLo[0], scalarLo[1], scalarLo[2]), glm::dvec3(scalarHi[0], scalarHi[1], scalarHi[2])};
+    t.bounds =
+        Box{glm::dvec3(scalarLo[0], scalarLo[1], scalarLo[2]), glm::dvec3(scalarHi[0], scalarHi[1], scalarHi[2])};
   return t;
 }
 
