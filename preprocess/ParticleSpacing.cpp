@@ -4,9 +4,11 @@
 #include "preprocess/particles/PointSpanSource.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <numbers>
 #include <random>
@@ -31,6 +33,8 @@ constexpr std::size_t kNeighbours = kSpacingNeighbour;
 /// The cells of KthNeighbours: half the radius, at most this many (4 MiB of bits; coarser cells
 /// beyond).
 constexpr double kMaxSearchCells = double(std::size_t(1) << 25);
+/// ... and at most this many along an axis (a bound on the rounding of cellsOf).
+constexpr double kMaxAxisCells = 4096;
 
 /// Spacing per k-th neighbour distance r: at spacing r * ballFactor(), a ball of radius r holds k particles.
 double ballFactor() { return std::cbrt(4 * std::numbers::pi / (3 * double(kSpacingNeighbour))); }
@@ -129,8 +133,10 @@ class KthNeighbours {
       lo = glm::min(lo, glm::dvec3(q));
       hi = glm::max(hi, glm::dvec3(q));
     }
-    mLo = lo - radius;
-    mHi = hi + radius;
+    for (int a = 0; a < 3; ++a) {
+      mLo[a] = roundedToFloat(lo[a] - radius, -1);
+      mHi[a] = roundedToFloat(hi[a] + radius, +1);
+    }
     const glm::dvec3 extent = mHi - mLo;
     mUsable = !queries.positions.empty() && radius > 0 && std::isfinite(extent.x + extent.y + extent.z);
     if (mUsable) buildCellLists();
@@ -138,11 +144,11 @@ class KthNeighbours {
 
   /// Candidates with consecutive ids from `firstId` (the source's order).
   void add(std::span<const glm::vec3> candidates, std::uint64_t firstId) {
-    addAll(candidates.size(), [&](std::size_t i) { return std::pair(candidates[i], firstId + i); });
+    addAll(candidates, [&](std::size_t i) { return firstId + i; });
   }
   /// Candidates with the given ids.
   void add(std::span<const glm::vec3> candidates, std::span<const std::uint64_t> ids) {
-    addAll(candidates.size(), [&](std::size_t i) { return std::pair(candidates[i], ids[i]); });
+    addAll(candidates, [&](std::size_t i) { return ids[i]; });
   }
 
   /// Each query's k-th neighbour distance, +inf where it lies beyond the radius.
@@ -171,6 +177,15 @@ class KthNeighbours {
 
  private:
   static constexpr float kInf = std::numeric_limits<float>::infinity();
+  /// Candidates whose cells are found at a time (cellsOf).
+  static constexpr std::size_t kBlock = 256;
+
+  /// v as a float (exactly), rounded down (`direction` -1) or up (+1).
+  static double roundedToFloat(double v, int direction) {
+    float f = float(v);
+    if (direction < 0 ? double(f) > v : double(f) < v) f = std::nextafter(f, direction < 0 ? -kInf : kInf);
+    return f;
+  }
 
   /// Calls visit(bit) for each cell within reach of `query`: whose box holds a point at most
   /// `reach` from it.
@@ -212,11 +227,19 @@ class KthNeighbours {
       mCell *= std::max(1.01, std::cbrt(dims.x * dims.y * dims.z / kMaxSearchCells) * 1.01);
       dims = cellsFor(mCell);
     }
+    const double longest = std::max({dims.x, dims.y, dims.z});
+    if (longest > kMaxAxisCells) {
+      mCell *= longest / kMaxAxisCells * 1.01;
+      dims = cellsFor(mCell);
+    }
     mInverseCell = 1 / mCell;
     mDims = glm::ivec3(dims);
     const std::size_t words = (std::size_t(dims.x * dims.y * dims.z) + 63) / 64;
-    constexpr double kSlack = 1e-6;
-    const double reach = mRadius * (1 + kSlack) + mCell * kSlack;
+    // The margin of the reach: a candidate's cell, found in floats (cellsOf), may be one whose
+    // box it misses by a few float roundings of its coordinate in cells (at most kMaxAxisCells):
+    // 3 * 2^-24 * 4096 = 0.0007 cells, under kCellSlack.
+    constexpr double kSlack = 1e-6, kCellSlack = 0x1p-9;
+    const double reach = mRadius * (1 + kSlack) + mCell * kCellSlack;
     // Queries in the order of their cells, so that the cells each visits next lie in memory near
     // those of the one before: each pass below walks the bits and lists about in order.
     const std::size_t n = mQueries.positions.size();
@@ -227,8 +250,10 @@ class KthNeighbours {
     // list's length, and the lists.
     std::vector<std::pair<std::uint32_t, std::uint32_t>> near;
     near.reserve(n * 27);
-    for (const auto& [cell, j] : order)
+    for (const auto& entry : order) {
+      const std::uint32_t j = entry.second;
       forEachCellNear(mQueries.positions[j], reach, [&](std::size_t bit) { near.emplace_back(std::uint32_t(bit), j); });
+    }
     mBits.assign(words, 0);
     for (const auto& [bit, j] : near) mBits[bit / 64] |= std::uint64_t(1) << (bit % 64);
     mWordRank.resize(words + 1);
@@ -257,15 +282,23 @@ class KthNeighbours {
     float distance2;
   };
 
-  /// Finds the hits of candidates [0, n) in parallel, then merges them into the heaps.
-  template <class Candidate>
-  void addAll(std::size_t n, Candidate candidate) {
+  /// Finds the hits of the candidates in parallel, then merges them into the heaps. `idOf(i)`:
+  /// candidate i's id.
+  template <class IdOf>
+  void addAll(std::span<const glm::vec3> candidates, IdOf idOf) {
     if (!mUsable) return;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& range) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, candidates.size(), 4096), [&](const auto& range) {
       std::vector<Hit>& hits = mHits.local();
-      for (std::size_t i = range.begin(); i != range.end(); ++i) {
-        const auto [position, id] = candidate(i);
-        visit(position, id, hits);
+      std::array<std::int32_t, kBlock> cells;
+      for (std::size_t first = range.begin(); first < range.end(); first += kBlock) {
+        const std::size_t count = std::min(kBlock, range.end() - first);
+        cellsOf(&candidates[first], count, cells.data());
+        for (std::size_t k = 0; k < count; ++k) {
+          if (cells[k] < 0) continue;
+          const std::size_t bit = std::size_t(cells[k]);
+          const std::uint64_t word = mBits[bit / 64];
+          if (word >> (bit % 64) & 1) measure(candidates[first + k], idOf(first + k), listOf(bit, word), hits);
+        }
       }
     });
     for (std::vector<Hit>& hits : mHits) {
@@ -280,14 +313,41 @@ class KthNeighbours {
     }
   }
 
-  void visit(const glm::vec3& candidate, std::uint64_t id, std::vector<Hit>& hits) const {
-    if (!isFinite(candidate)) return;
-    const glm::dvec3 p(candidate);
-    if (p.x < mLo.x || p.y < mLo.y || p.z < mLo.z || p.x > mHi.x || p.y > mHi.y || p.z > mHi.z) return;
-    const std::size_t bit = cellIndex(p);
-    const std::uint64_t word = mBits[bit / 64];
-    if (!(word >> (bit % 64) & 1)) return;
-    const std::size_t list = listOf(bit, word);
+  /// The cell (its bit) of each of `n` <= kBlock candidates, -1 for one outside [mLo, mHi] (NaN
+  /// and Inf among them). In floats, four candidates at a time: mLo and mHi are floats, and the
+  /// reach's margin covers the rounding (buildCellLists). `cells` has room for n rounded up to 4.
+  void cellsOf(const glm::vec3* p, std::size_t n, std::int32_t* cells) const {
+    using Lanes = float __attribute__((vector_size(16)));
+    using Ints = std::int32_t __attribute__((vector_size(16)));
+    alignas(16) float x[kBlock], y[kBlock], z[kBlock];
+    for (std::size_t k = 0; k < n; ++k) x[k] = p[k].x, y[k] = p[k].y, z[k] = p[k].z;
+    for (std::size_t k = n; k % 4; ++k) x[k] = y[k] = z[k] = std::numeric_limits<float>::quiet_NaN();  // outside
+    const glm::vec3 lo(mLo), hi(mHi);
+    const float inverse = float(mInverseCell);
+    const glm::ivec3 last = mDims - 1;
+    // The cell along an axis: 0 outside (NaN and the out of range do not convert to int).
+    const auto axisCell = [&](const Lanes& v, float low, std::int32_t lastCell, const Ints& inside) {
+      const Ints c = __builtin_convertvector((Lanes)((Ints)((v - low) * inverse) & inside), Ints);
+      const Ints beyond = c > lastCell;
+      return (c & ~beyond) | (lastCell & beyond);
+    };
+    for (std::size_t k = 0; k < n; k += 4) {
+      Lanes vx, vy, vz;
+      std::memcpy(&vx, x + k, sizeof vx);
+      std::memcpy(&vy, y + k, sizeof vy);
+      std::memcpy(&vz, z + k, sizeof vz);
+      const Ints inside =
+          (vx >= lo.x) & (vx <= hi.x) & (vy >= lo.y) & (vy <= hi.y) & (vz >= lo.z) & (vz <= hi.z);
+      const Ints cell =
+          (axisCell(vz, lo.z, last.z, inside) * mDims.y + axisCell(vy, lo.y, last.y, inside)) * mDims.x +
+          axisCell(vx, lo.x, last.x, inside);
+      const Ints result = cell | ~inside;  // -1 outside
+      std::memcpy(cells + k, &result, sizeof result);
+    }
+  }
+
+  /// Measures a candidate whose cell has a list against the list's queries.
+  void measure(const glm::vec3& candidate, std::uint64_t id, std::size_t list, std::vector<Hit>& hits) const {
     const float radius2 = float(mRadius * mRadius);
     for (std::uint32_t i = mListStart[list]; i < mListStart[list + 1]; ++i) {
       const std::uint32_t j = mListed[i];
@@ -300,7 +360,7 @@ class KthNeighbours {
 
   const Sample& mQueries;
   double mRadius;
-  glm::dvec3 mLo{0}, mHi{0};  ///< the queries' bounds grown by the radius
+  glm::dvec3 mLo{0}, mHi{0};  ///< the queries' bounds grown by the radius, rounded out to floats
   bool mUsable = false;
   double mCell = 0, mInverseCell = 0;
   glm::ivec3 mDims{0};                    ///< of the cells over [mLo, mHi]
