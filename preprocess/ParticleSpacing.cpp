@@ -336,11 +336,9 @@ class KthNeighbours {
       std::memcpy(&vx, x + k, sizeof vx);
       std::memcpy(&vy, y + k, sizeof vy);
       std::memcpy(&vz, z + k, sizeof vz);
-      const Ints inside =
-          (vx >= lo.x) & (vx <= hi.x) & (vy >= lo.y) & (vy <= hi.y) & (vz >= lo.z) & (vz <= hi.z);
-      const Ints cell =
-          (axisCell(vz, lo.z, last.z, inside) * mDims.y + axisCell(vy, lo.y, last.y, inside)) * mDims.x +
-          axisCell(vx, lo.x, last.x, inside);
+      const Ints inside = (vx >= lo.x) & (vx <= hi.x) & (vy >= lo.y) & (vy <= hi.y) & (vz >= lo.z) & (vz <= hi.z);
+      const Ints cell = (axisCell(vz, lo.z, last.z, inside) * mDims.y + axisCell(vy, lo.y, last.y, inside)) * mDims.x +
+                        axisCell(vx, lo.x, last.x, inside);
       const Ints result = cell | ~inside;  // -1 outside
       std::memcpy(cells + k, &result, sizeof result);
     }
