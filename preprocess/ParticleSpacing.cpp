@@ -111,13 +111,14 @@ Sample reservoirSample(ParticleSource& source, std::size_t size, Progress* progr
 
 /// The k-th neighbour distance of every query among the candidates given to add(), searched as
 /// far as `radius`: a query whose k-th neighbour is farther keeps +inf. A grid of cells of half
-/// the radius (coarser where that would exceed kMaxSearchCells) covers the queries' bounds grown
-/// by the radius, and each cell lists the queries within reach of some point of it. A candidate
-/// looks up its own cell only: a bit turns it away when the list is empty (most candidates lie
-/// far from every query), else it measures its distance to each listed query. The reach is the
-/// radius plus a margin (kSlack) so that rounding in a candidate's cell index never hides a query
-/// within the radius: the lists are a superset, and the search is exact. A candidate with the id
-/// of a query is that query itself and skipped.
+/// the radius or of the radius (coarser where that would exceed kMaxSearchCells, or
+/// kMaxAxisCells along an axis) covers the queries' bounds grown by the radius, and each cell
+/// lists the queries within reach of some point of it. A candidate looks up its own cell only
+/// (found in floats, four at a time): a bit turns it away when the list is empty (most
+/// candidates lie far from every query), else it measures its distance to each listed query.
+/// The reach is the radius plus a margin for the rounding of a candidate's cell, so the lists
+/// are a superset and the search is exact. A candidate with the id of a query is that query
+/// itself and skipped.
 class KthNeighbours {
  public:
   /// `fine`: cells of half the radius, for many candidates per query (a frame against its
@@ -235,9 +236,10 @@ class KthNeighbours {
     mInverseCell = 1 / mCell;
     mDims = glm::ivec3(dims);
     const std::size_t words = (std::size_t(dims.x * dims.y * dims.z) + 63) / 64;
-    // The margin of the reach: a candidate's cell, found in floats (cellsOf), may be one whose
-    // box it misses by a few float roundings of its coordinate in cells (at most kMaxAxisCells):
-    // 3 * 2^-24 * 4096 = 0.0007 cells, under kCellSlack.
+    // The margins of the reach: kCellSlack, as a candidate's cell, found in floats (cellsOf), may
+    // be one whose box it misses by three float roundings of its coordinate in cells (at most
+    // kMaxAxisCells): 3 * 2^-24 * 4096 = 0.0007 cells; kSlack, the double rounding of the
+    // distances from a query to the cells' boxes (forEachCellNear).
     constexpr double kSlack = 1e-6, kCellSlack = 0x1p-9;
     const double reach = mRadius * (1 + kSlack) + mCell * kCellSlack;
     // Queries in the order of their cells, so that the cells each visits next lie in memory near
@@ -249,7 +251,6 @@ class KthNeighbours {
     // Each (cell, query) pair once, then the bits, the rank of each word's first bit, each
     // list's length, and the lists.
     std::vector<std::pair<std::uint32_t, std::uint32_t>> near;
-    near.reserve(n * 27);
     for (const auto& entry : order) {
       const std::uint32_t j = entry.second;
       forEachCellNear(mQueries.positions[j], reach, [&](std::size_t bit) { near.emplace_back(std::uint32_t(bit), j); });
