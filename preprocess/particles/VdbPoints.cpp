@@ -1,10 +1,9 @@
 // OpenVDB point files written through OpenVDB: one PointDataGrid 'particles' with P (and the
-// velocity `v` when asked), stored as io::Stream writes it. Reading is VdbPointsReader.cpp, our
-// own bounds-checked decoder; OpenVDB's reader is only the oracle of its tests.
-#include <openvdb/io/Stream.h>
-#include <openvdb/openvdb.h>
-#include <openvdb/points/PointConversion.h>
-#include <openvdb/points/PointDataGrid.h>
+// velocity `v` when asked), stored as io::Stream writes it. The writing itself is OpenVDB's, in
+// a module loaded here on first use (VdbWriterModule.h: libflipscope_vdb_writer.so); this side
+// gathers the particles and owns the file. Reading is VdbPointsReader.cpp, our own
+// bounds-checked decoder; OpenVDB's reader is only the oracle of its tests.
+#include <dlfcn.h>
 
 #include <cmath>
 #include <mutex>
@@ -14,16 +13,42 @@
 #include "core/AtomicFile.h"
 #include "core/Error.h"
 #include "preprocess/particles/ParticleFormats.h"
+#include "preprocess/particles/VdbWriterModule.h"
 
 namespace flipscope::detail {
 namespace {
 
-using openvdb::points::PointDataGrid;
-
-/// Initializes OpenVDB once (thread safe).
-void initializeOpenVdb() {
+/// The module's WriteFunction, loaded once: from beside the running binary, else from the build
+/// tree this code was built in (the tests' binaries lie below it). Throws `OutputError` naming
+/// `destination`, the places looked in and why the loader refused, when neither loads.
+vdbwriter::WriteFunction writeFunction(const std::filesystem::path& destination) {
   static std::once_flag once;
-  std::call_once(once, [] { openvdb::initialize(); });
+  static vdbwriter::WriteFunction function = nullptr;
+  static std::string refused;
+  std::call_once(once, [] {
+    std::vector<std::filesystem::path> places;
+    std::error_code ec;
+    const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
+    if (!ec) places.push_back(self.parent_path() / vdbwriter::kModuleFile);
+    const std::filesystem::path built = std::filesystem::path(FLIPSCOPE_BUILD_DIR) / vdbwriter::kModuleFile;
+    if (places.empty() || places.front() != built) places.push_back(built);
+    for (const auto& place : places) {
+      void* module = ::dlopen(place.c_str(), RTLD_NOW | RTLD_LOCAL);
+      if (!module) {
+        const char* why = ::dlerror();
+        refused += (refused.empty() ? "" : "; ") + std::string(why ? why : place.string() + ": not loaded");
+        continue;
+      }
+      function = reinterpret_cast<vdbwriter::WriteFunction>(::dlsym(module, vdbwriter::kEntryPoint));
+      if (function) return;  // the module stays loaded
+      refused += (refused.empty() ? "" : "; ") + place.string() + " has no " + vdbwriter::kEntryPoint;
+      ::dlclose(module);
+    }
+  });
+  if (!function)
+    throw OutputError(destination, std::string("writing OpenVDB points needs ") + vdbwriter::kModuleFile +
+                                       " beside the flipscope binary (" + refused + ")");
+  return function;
 }
 
 /// Unbuffered std::streambuf that appends to an AtomicFile (which buffers itself).
@@ -47,15 +72,10 @@ class AtomicFileStreamBuffer final : public std::streambuf {
   AtomicFile& mFile;
 };
 
-/// Points a PointDataGrid can store: voxel coordinates must fit OpenVDB's 32-bit Coord.
-constexpr double kMaxVoxelCoordinate = 1 << 30;
-/// Average points per occupied voxel aimed at when the voxel size comes from the points.
-constexpr std::uint32_t kPointsPerVoxel = 8;
-
 class VdbPointsWriter final : public ParticleWriter {
  public:
   VdbPointsWriter(const std::filesystem::path& path, const WriteOptions& options) : mFile(path), mOptions(options) {
-    initializeOpenVdb();
+    writeFunction(path);  // a missing module says so before any particle is gathered
   }
 
   void write(const ParticleChunk& chunk) override {
@@ -67,38 +87,24 @@ class VdbPointsWriter final : public ParticleWriter {
         throw InputError(mFile.destination().string() +
                          ": OpenVDB points cannot store the non-finite position of particle " +
                          std::to_string(mPositions.size()));
-      mPositions.emplace_back(p.x, p.y, p.z);
-      if (mOptions.velocity) {
-        const glm::vec3& v = chunk.velocities[k];
-        mVelocities.emplace_back(v.x, v.y, v.z);
-      }
+      mPositions.push_back(p);
+      if (mOptions.velocity) mVelocities.push_back(chunk.velocities[k]);
     }
   }
 
   void commit() override {
-    namespace points = openvdb::points;
-    points::PointAttributeVector<openvdb::Vec3f> positions(mPositions);
-    double voxelSize = mOptions.vdbVoxelSize;
-    if (voxelSize <= 0) voxelSize = mPositions.empty() ? 1.0 : points::computeVoxelSize(positions, kPointsPerVoxel);
-    if (!(voxelSize > 0) || !std::isfinite(voxelSize)) voxelSize = 1.0;
-    for (const auto& p : mPositions)
-      if (std::abs(p.x()) / voxelSize > kMaxVoxelCoordinate || std::abs(p.y()) / voxelSize > kMaxVoxelCoordinate ||
-          std::abs(p.z()) / voxelSize > kMaxVoxelCoordinate)
-        throw InputError(mFile.destination().string() + ": position " + p.str() +
-                         " is too far from the origin for voxel size " + std::to_string(voxelSize));
-    auto transform = openvdb::math::Transform::createLinearTransform(voxelSize);
-    auto index = openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(positions, *transform);
-    auto grid = points::createPointDataGrid<points::NullCodec, PointDataGrid>(*index, positions, *transform);
-    if (mOptions.velocity) {
-      points::appendAttribute<openvdb::Vec3f>(grid->tree(), "v");
-      points::PointAttributeVector<openvdb::Vec3f> velocities(mVelocities);
-      points::populateAttribute(grid->tree(), index->tree(), "v", velocities);
-    }
-    grid->setName("particles");
+    static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
+    vdbwriter::Points points;
+    points.positions = &mPositions.data()->x;
+    points.velocities = mOptions.velocity ? &mVelocities.data()->x : nullptr;
+    points.count = mPositions.size();
+    points.voxelSize = mOptions.vdbVoxelSize;
     AtomicFileStreamBuffer buffer(mFile);
     std::ostream stream(&buffer);
     stream.exceptions(std::ios::badbit | std::ios::failbit);
-    openvdb::io::Stream(stream).write(openvdb::GridCPtrVec{grid});
+    char error[512] = {};
+    if (!writeFunction(mFile.destination())(points, stream, error, sizeof error))
+      throw InputError(mFile.destination().string() + ": " + error);
     stream.flush();
     mFile.commit();
   }
@@ -106,8 +112,8 @@ class VdbPointsWriter final : public ParticleWriter {
  private:
   AtomicFile mFile;
   WriteOptions mOptions;
-  std::vector<openvdb::Vec3f> mPositions;
-  std::vector<openvdb::Vec3f> mVelocities;
+  std::vector<glm::vec3> mPositions;
+  std::vector<glm::vec3> mVelocities;
 };
 
 }  // namespace

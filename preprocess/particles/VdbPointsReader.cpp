@@ -217,6 +217,42 @@ void decodeComponents(const std::byte* stored, float* out) {
   for (std::size_t i = 0; i < n; ++i) out[i] = static_cast<float>(parts[i]);
 }
 
+/// OpenVDB's "uvec" codec (points::UnitVecCodec: math::QuantizedUnitVec, after "Higher Accuracy
+/// Quantized Normals", GameDev.net 2000), decoded here because OpenVDB's decode reads a table in
+/// its library, which the reader does not link. The table is computed the way OpenVDB's source
+/// (QuantizedUnitVec.cc) generates its own; the decode is unpack()'s arithmetic.
+struct UnitVecCodec {
+  template <class T>
+  struct Storage {
+    using Type = std::uint16_t;
+  };
+  static const char* name() { return "uvec"; }
+  static void decode(const std::uint16_t& data, Vec3f& value) {
+    static const std::array<float, 8192> weights = [] {
+      std::array<float, 8192> w{};
+      for (std::uint32_t b = 0; b < w.size(); ++b) {
+        auto [x, y] = xyBits(b);
+        const double dx = x, dy = y, dz = 126 - x - y;
+        w[b] = float(1.0 / std::sqrt(dx * dx + dy * dy + dz * dz));
+      }
+      return w;
+    }();
+    const float w = weights[data & 0x1fff];
+    const auto [x, y] = xyBits(data);
+    value = Vec3f(float(x) * w, float(y) * w, float(126 - x - y) * w);
+    if (data & 0x8000) value[0] = -value[0];
+    if (data & 0x4000) value[1] = -value[1];
+    if (data & 0x2000) value[2] = -value[2];
+  }
+
+ private:
+  /// The two stored components, 0 to 126, the complement stored where their sum passes 126.
+  static std::pair<int, int> xyBits(std::uint32_t data) {
+    const int x = int((data & 0x1f80) >> 7), y = int(data & 0x7f);
+    return x + y > 126 ? std::pair(127 - x, 127 - y) : std::pair(x, y);
+  }
+};
+
 /// A value type and codec as a descriptor names them, and how to list and decode them.
 struct CodecEntry {
   std::string type, codec;
@@ -265,7 +301,7 @@ const std::vector<CodecEntry>& codecTable() {
       codecEntry<Vec3f, float, p::FixedPointCodec<false, p::PositionRange>>(V::Float32),
       codecEntry<Vec3f, float, p::FixedPointCodec<true, p::UnitRange>>(V::Float32),
       codecEntry<Vec3f, float, p::FixedPointCodec<false, p::UnitRange>>(V::Float32),
-      codecEntry<Vec3f, float, p::UnitVecCodec>(V::Float32),
+      codecEntry<Vec3f, float, UnitVecCodec>(V::Float32),
       codecEntry<Vec3d, double, p::NullCodec>(V::Float64),
       codecEntry<m::Vec3<std::int32_t>, std::int32_t, p::NullCodec>(V::Int32),
       codecEntry<m::Vec2<float>, float, p::NullCodec>(V::Float32),
@@ -308,7 +344,7 @@ const Vec3Codec* findVec3Codec(const std::string& name) {
       {"fxpt16", vec3Codec<p::FixedPointCodec<false, p::PositionRange>>()},
       {"ufxpt8", vec3Codec<p::FixedPointCodec<true, p::UnitRange>>()},
       {"ufxpt16", vec3Codec<p::FixedPointCodec<false, p::UnitRange>>()},
-      {"uvec", vec3Codec<p::UnitVecCodec>()},
+      {"uvec", vec3Codec<UnitVecCodec>()},
   }};
   for (const auto& [codecName, codec] : kCodecs)
     if (name == codecName) return &codec;
