@@ -22,9 +22,10 @@
 // not found within kSpacingMaxPasses reads of the source.
 // Cost of the neighbour estimate: one read of the source when it has at most kSpacingSample
 // particles, else two (rarely more); memory O(kSpacingSample) plus one chunk of particles, plus
-// at most about 40 MiB, whatever the frame's size, for the search's cells near the sample: 4 MiB
-// of bits and, per cell within the search radius of a sampled particle (at most 216 each), the
-// list of those particles. The source is rewound afterwards.
+// at most about 100 MiB, whatever the frame's size, for the search's cells near the sample (30
+// MiB on the frames measured): 4 MiB of bits and, per cell within the search radius of a
+// sampled particle (at most 216 each), the list of those particles. The source is rewound
+// afterwards.
 #pragma once
 
 #include <cstddef>

@@ -9,6 +9,8 @@
 #include <mutex>
 #include <ostream>
 #include <streambuf>
+#include <string>
+#include <vector>
 
 #include "core/AtomicFile.h"
 #include "core/Error.h"
@@ -95,9 +97,10 @@ class VdbPointsWriter final : public ParticleWriter {
   void commit() override {
     static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
     vdbwriter::Points points;
-    points.positions = &mPositions.data()->x;
-    points.velocities = mOptions.velocity ? &mVelocities.data()->x : nullptr;
+    points.positions = reinterpret_cast<const float*>(mPositions.data());
+    points.velocities = reinterpret_cast<const float*>(mVelocities.data());
     points.count = mPositions.size();
+    points.velocity = mOptions.velocity;
     points.voxelSize = mOptions.vdbVoxelSize;
     AtomicFileStreamBuffer buffer(mFile);
     std::ostream stream(&buffer);

@@ -20,12 +20,13 @@ inline constexpr char kModuleFile[] = "libflipscope_vdb_writer.so";
 /// The name of its WriteFunction.
 inline constexpr char kEntryPoint[] = "flipscopeWriteVdbPoints";
 
-/// The particles of one file: `count` positions (x y z floats, finite), and as many velocities
-/// or none.
+/// The particles of one file: `count` positions (x y z floats, finite), and with `velocity` as
+/// many velocities.
 struct Points {
   const float* positions = nullptr;
-  const float* velocities = nullptr;  ///< null: no velocity attribute
+  const float* velocities = nullptr;
   std::size_t count = 0;
+  bool velocity = false;  ///< whether to write the attribute `v`
   double voxelSize = 0;  ///< of the point grid; 0: from the points, about 8 a voxel
 };
 

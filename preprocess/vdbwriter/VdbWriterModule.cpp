@@ -30,10 +30,10 @@ bool write(const Points& in, std::ostream& out, char* error, std::size_t errorBy
   static std::once_flag once;
   std::call_once(once, [] { openvdb::initialize(); });
   namespace points = openvdb::points;
-  std::vector<openvdb::Vec3f> positions(in.count), velocities(in.velocities ? in.count : 0);
+  std::vector<openvdb::Vec3f> positions(in.count), velocities(in.velocity ? in.count : 0);
   for (std::size_t i = 0; i < in.count; ++i) {
     positions[i] = openvdb::Vec3f(in.positions + 3 * i);
-    if (in.velocities) velocities[i] = openvdb::Vec3f(in.velocities + 3 * i);
+    if (in.velocity) velocities[i] = openvdb::Vec3f(in.velocities + 3 * i);
   }
   points::PointAttributeVector<openvdb::Vec3f> wrapped(positions);
   double voxelSize = in.voxelSize;
@@ -49,7 +49,7 @@ bool write(const Points& in, std::ostream& out, char* error, std::size_t errorBy
   auto transform = openvdb::math::Transform::createLinearTransform(voxelSize);
   auto index = openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(wrapped, *transform);
   auto grid = points::createPointDataGrid<points::NullCodec, points::PointDataGrid>(*index, wrapped, *transform);
-  if (in.velocities) {
+  if (in.velocity) {
     points::appendAttribute<openvdb::Vec3f>(grid->tree(), "v");
     points::PointAttributeVector<openvdb::Vec3f> wrappedVelocities(velocities);
     points::populateAttribute(grid->tree(), index->tree(), "v", wrappedVelocities);

@@ -170,5 +170,23 @@ TEST(VdbWriter, RejectsNonFinitePositions) {
   }
 }
 
+TEST(VdbWriter, APositionBeyondTheGridsReachIsAnErrorNamingTheFile) {
+  // The writer is a module (preprocess/vdbwriter/): its refusal comes back as the file's error,
+  // and nothing is left behind.
+  TempDir dir("vdb-far");
+  auto particles = randomParticles(10, true, 4);
+  particles.positions[6] = {1e30f, 0.0f, 0.0f};
+  WriteOptions options;
+  options.vdbVoxelSize = 1.0f;
+  try {
+    writeFile(dir / "far.vdb", particles, options);
+    FAIL() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("far.vdb"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("too far from the origin for voxel size 1"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
+}
+
 }  // namespace
 }  // namespace flipscope
