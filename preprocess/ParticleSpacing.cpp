@@ -19,7 +19,6 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <glm/common.hpp>
-#include <glm/vector_relational.hpp>
 #include <glm/vec3.hpp>
 
 #include "core/Error.h"

@@ -10,7 +10,6 @@
 #include <mutex>
 #include <string>
 #include <type_traits>
-#include <vector>
 
 #include "preprocess/particles/VdbWriterModule.h"
 
@@ -22,6 +21,23 @@ constexpr double kMaxVoxelCoordinate = 1 << 30;
 /// Average points per occupied voxel aimed at when the voxel size comes from the points.
 constexpr std::uint32_t kPointsPerVoxel = 8;
 
+/// x y z floats as OpenVDB's point conversion reads them (the interface of
+/// points::PointAttributeVector), without copying them into a vector of its own.
+class FloatTriples {
+ public:
+  using PosType = openvdb::Vec3f;
+  using value_type = openvdb::Vec3f;
+  FloatTriples(const float* data, std::size_t count) : mData(data), mCount(count) {}
+  std::size_t size() const { return mCount; }
+  void getPos(std::size_t n, openvdb::Vec3f& xyz) const { xyz = openvdb::Vec3f(mData + 3 * n); }
+  void get(openvdb::Vec3f& value, std::size_t n) const { value = openvdb::Vec3f(mData + 3 * n); }
+  void get(openvdb::Vec3f& value, std::size_t n, openvdb::Index) const { get(value, n); }
+
+ private:
+  const float* mData;
+  std::size_t mCount;
+};
+
 void fail(const std::string& message, char* error, std::size_t errorBytes) {
   if (errorBytes > 0) std::snprintf(error, errorBytes, "%s", message.c_str());
 }
@@ -30,29 +46,26 @@ bool write(const Points& in, std::ostream& out, char* error, std::size_t errorBy
   static std::once_flag once;
   std::call_once(once, [] { openvdb::initialize(); });
   namespace points = openvdb::points;
-  std::vector<openvdb::Vec3f> positions(in.count), velocities(in.velocity ? in.count : 0);
-  for (std::size_t i = 0; i < in.count; ++i) {
-    positions[i] = openvdb::Vec3f(in.positions + 3 * i);
-    if (in.velocity) velocities[i] = openvdb::Vec3f(in.velocities + 3 * i);
-  }
-  points::PointAttributeVector<openvdb::Vec3f> wrapped(positions);
+  const FloatTriples positions(in.positions, in.count);
   double voxelSize = in.voxelSize;
-  if (voxelSize <= 0) voxelSize = positions.empty() ? 1.0 : points::computeVoxelSize(wrapped, kPointsPerVoxel);
+  if (voxelSize <= 0) voxelSize = in.count == 0 ? 1.0 : points::computeVoxelSize(positions, kPointsPerVoxel);
   if (!(voxelSize > 0) || !std::isfinite(voxelSize)) voxelSize = 1.0;
-  for (const auto& p : positions)
+  for (std::size_t i = 0; i < in.count; ++i) {
+    openvdb::Vec3f p;
+    positions.getPos(i, p);
     if (std::abs(p.x()) / voxelSize > kMaxVoxelCoordinate || std::abs(p.y()) / voxelSize > kMaxVoxelCoordinate ||
         std::abs(p.z()) / voxelSize > kMaxVoxelCoordinate) {
       fail("position " + p.str() + " is too far from the origin for voxel size " + std::to_string(voxelSize), error,
            errorBytes);
       return false;
     }
+  }
   auto transform = openvdb::math::Transform::createLinearTransform(voxelSize);
-  auto index = openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(wrapped, *transform);
-  auto grid = points::createPointDataGrid<points::NullCodec, points::PointDataGrid>(*index, wrapped, *transform);
+  auto index = openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(positions, *transform);
+  auto grid = points::createPointDataGrid<points::NullCodec, points::PointDataGrid>(*index, positions, *transform);
   if (in.velocity) {
     points::appendAttribute<openvdb::Vec3f>(grid->tree(), "v");
-    points::PointAttributeVector<openvdb::Vec3f> wrappedVelocities(velocities);
-    points::populateAttribute(grid->tree(), index->tree(), "v", wrappedVelocities);
+    points::populateAttribute(grid->tree(), index->tree(), "v", FloatTriples(in.velocities, in.count));
   }
   grid->setName("particles");
   openvdb::io::Stream(out).write(openvdb::GridCPtrVec{grid});
