@@ -11,6 +11,7 @@
 #include <cstring>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <vector>
@@ -50,28 +51,55 @@ std::string text(double v) {
 struct Sample {
   std::vector<glm::vec3> positions;
   std::vector<std::uint64_t> ids;  ///< index of each sampled particle in the source's order
-  std::uint64_t finite = 0;        ///< finite particles in the whole source
-  Box bounds;                      ///< of the finite particles of the whole source
-  bool complete() const { return finite == positions.size(); }
+  std::uint64_t finite = 0;        ///< finite particles in the whole source (once `counted`)
+  Box bounds;                      ///< of the finite particles of the whole source (once `counted`)
+  bool counted = false;            ///< the sample was drawn reading the whole source: finite and bounds are known
+  bool complete() const { return counted && finite == positions.size(); }
 };
 
-/// Reservoir sampling of the finite particles (Li's algorithm L: a random skip to the next
-/// particle that enters the sample, so random numbers are drawn only for those, about
-/// size * ln(finite / size) of them), one read of the source, then a rewind. The count and the
-/// bounds of the finite particles are gathered on the way, in parallel over each chunk.
+/// Li's algorithm L: which items of a stream numbered 0, 1, 2, ... enter a uniform random
+/// sample of `size` items, and the slot each takes. After the first `size`, a random skip leads
+/// to the next item that enters, so random numbers are drawn only for those, about
+/// size * ln(items / size) of them. A fixed seed: the same items for the same stream length.
+class ReservoirSkips {
+ public:
+  explicit ReservoirSkips(std::size_t size) : mSize(size), mW(std::exp(std::log(open()) / double(size))) {}
+  /// The item that enters the sample next.
+  std::uint64_t next() const { return mNext; }
+  /// Item next() enters the sample: the slot it takes (0, 1, ... while the sample fills).
+  std::size_t enter() {
+    if (mNext < mSize) {
+      const std::size_t slot = std::size_t(mNext);
+      mNext += mNext + 1 == mSize ? skip() : 1;
+      return slot;
+    }
+    const std::size_t slot = std::uniform_int_distribution<std::size_t>(0, mSize - 1)(mRng);
+    mW *= std::exp(std::log(open()) / double(mSize));
+    mNext += skip();
+    return slot;
+  }
+
+ private:
+  double open() { return 1.0 - mUniform(mRng); }  // in (0, 1]: its log is finite
+  std::uint64_t skip() {
+    const double gap = std::floor(std::log(open()) / std::log1p(-mW));
+    return gap < 0x1p62 ? std::uint64_t(gap) + 1 : std::uint64_t(1) << 62;  // (w so small: never)
+  }
+
+  std::mt19937_64 mRng{0x5041434eull};
+  std::uniform_real_distribution<double> mUniform{0.0, 1.0};
+  std::size_t mSize;
+  double mW;
+  std::uint64_t mNext = 0;
+};
+
+/// Reservoir sampling of the finite particles, one read of the source, then a rewind. The
+/// count and the bounds of the finite particles are gathered on the way, in parallel over each
+/// chunk.
 Sample reservoirSample(ParticleSource& source, std::size_t size, Progress* progress) {
   Sample s;
-  std::mt19937_64 rng(0x5041434eull);
-  std::uniform_real_distribution<double> uniform(0.0, 1.0);
-  const auto open = [&] { return 1.0 - uniform(rng); };  // in (0, 1]: its log is finite
-  const double k = double(size);
-  double w = std::exp(std::log(open()) / k);
-  // The finite particle (counted from 0) that enters the sample next, once it is full.
-  const auto skip = [&] {
-    const double gap = std::floor(std::log(open()) / std::log1p(-w));
-    return gap < 0x1p62 ? std::uint64_t(gap) + 1 : std::uint64_t(1) << 62;  // (w so small: never)
-  };
-  std::uint64_t next = 0;
+  s.counted = true;
+  ReservoirSkips reservoir(size);
   ParticleChunk chunk;
   std::uint64_t id = 0;
   while (source.read(chunk, kChunkParticles)) {
@@ -82,20 +110,19 @@ Sample reservoirSample(ParticleSource& source, std::size_t size, Progress* progr
     std::uint64_t counted = s.finite;  // finite particles before p[i]
     for (std::size_t i = 0; i < p.size() && counted < end; ++i) {
       if (!isFinite(p[i])) continue;
-      if (s.positions.size() < size) {
-        s.positions.push_back(p[i]);
-        s.ids.push_back(id + i);
-        if (s.positions.size() == size) next = counted + skip();
-      } else if (counted == next) {
-        const auto slot = std::uniform_int_distribution<std::size_t>(0, size - 1)(rng);
-        s.positions[slot] = p[i];
-        s.ids[slot] = id + i;
-        w *= std::exp(std::log(open()) / k);
-        next = counted + skip();
+      if (counted == reservoir.next()) {
+        const std::size_t slot = reservoir.enter();
+        if (slot == s.positions.size()) {
+          s.positions.push_back(p[i]);
+          s.ids.push_back(id + i);
+        } else {
+          s.positions[slot] = p[i];
+          s.ids[slot] = id + i;
+        }
       } else if (p.size() - i == end - counted) {  // all finite from here: jump to the next one in
-        if (next >= end) break;                     // (none of them enters the sample)
-        i += std::size_t(next - counted) - 1;
-        counted = next - 1;
+        if (reservoir.next() >= end) break;        // (none of them enters the sample)
+        i += std::size_t(reservoir.next() - counted) - 1;
+        counted = reservoir.next() - 1;
       }
       ++counted;
     }
@@ -105,6 +132,34 @@ Sample reservoirSample(ParticleSource& source, std::size_t size, Progress* progr
     if (progress) progress->advance(chunk.size());
   }
   source.rewind();
+  return s;
+}
+
+/// The same sampling without reading the source whole, where it has more than `size` particles
+/// and seeks to one cheaply (ParticleSource::readPositionsAt): a sample of `size` of all its
+/// particles, by number, less the non-finite ones among them; not `counted`. Else nullopt.
+std::optional<Sample> sampleByNumber(ParticleSource& source, std::size_t size) {
+  const std::optional<std::uint64_t> count = source.countHint();
+  if (!count || *count <= size) return std::nullopt;
+  std::vector<std::uint64_t> ids;
+  ids.reserve(size);
+  for (ReservoirSkips reservoir(size); reservoir.next() < *count;) {
+    const std::uint64_t item = reservoir.next();
+    const std::size_t slot = reservoir.enter();
+    if (slot == ids.size())
+      ids.push_back(item);
+    else
+      ids[slot] = item;
+  }
+  std::sort(ids.begin(), ids.end());
+  Sample s;
+  if (!source.readPositionsAt(ids, s.positions)) return std::nullopt;
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    if (isFinite(s.positions[i])) {
+      s.positions[s.ids.size()] = s.positions[i];
+      s.ids.push_back(ids[i]);
+    }
+  s.positions.resize(s.ids.size());
   return s;
 }
 
@@ -423,26 +478,42 @@ SpacingEstimate hintSpacing(const SpacingHint& hint) {
 
 SpacingEstimate neighbourSpacing(ParticleSource& source, std::size_t sampleSize, Progress* progress) {
   sampleSize = std::max(sampleSize, kNeighbours + 1);
-  const Sample sample = reservoirSample(source, sampleSize, progress);
+  // By number where the source allows it (one read fewer), unless too few of those sampled are
+  // finite, or their distances say nothing: then the sample of a whole read, and its messages.
+  double median = 0;
+  std::optional<Sample> drawn = sampleByNumber(source, sampleSize);
+  if (drawn && drawn->positions.size() > kNeighbours) median = medianWithinSample(*drawn);
+  if (!(std::isfinite(median) && median > 0)) drawn.reset();
+  const Sample sample = drawn ? std::move(*drawn) : reservoirSample(source, sampleSize, progress);
   SpacingEstimate e;
-  e.bounds = sample.bounds;
-  if (sample.finite < kNeighbours + 1) {
+  if (sample.counted && sample.finite < kNeighbours + 1) {
+    e.bounds = sample.bounds;
     e.origin = "too few particles to measure (" + std::to_string(sample.finite) + " finite)";
     return e;
   }
-  double median = medianWithinSample(sample);
-  std::string of = "all " + std::to_string(sample.finite) + " particles";
+  if (!drawn) median = medianWithinSample(sample);
+  std::uint64_t finite = sample.finite;
+  Box bounds = sample.bounds;
   if (!sample.complete() && std::isfinite(median) && median > 0) {
-    // The sample is a random thinning to density n / N: distances shrink by cbrt(n / N).
-    of = std::to_string(sample.positions.size()) + " sampled of " + std::to_string(sample.finite) + " particles";
-    double radius = 1.5 * median * std::cbrt(double(sample.positions.size()) / double(sample.finite));
+    // The sample is a random thinning to density n / N: distances shrink by cbrt(n / N). A
+    // sample by number knows N only as the finite share of it.
+    const double particles = sample.counted
+                                 ? double(sample.finite)
+                                 : double(*source.countHint()) * double(sample.positions.size()) / double(sampleSize);
+    double radius = 1.5 * median * std::cbrt(double(sample.positions.size()) / particles);
     median = std::numeric_limits<double>::infinity();
     for (int pass = 1; pass < kSpacingMaxPasses && !std::isfinite(median); ++pass, radius *= 2) {
+      const bool counting = pass == 1 && !sample.counted;
       KthNeighbours search(sample, radius, true);
       ParticleChunk chunk;
       std::uint64_t id = 0;
       while (source.read(chunk, kChunkParticles)) {
         search.add(chunk.positions, id);
+        if (counting) {
+          const FiniteBounds tally = finiteBounds(chunk.positions);
+          finite += tally.finite;
+          bounds.extend(tally.bounds);
+        }
         id += chunk.size();
         if (progress) progress->advance(chunk.size());
       }
@@ -450,6 +521,10 @@ SpacingEstimate neighbourSpacing(ParticleSource& source, std::size_t sampleSize,
       median = search.median();
     }
   }
+  e.bounds = bounds;
+  const std::string of = sample.complete() ? "all " + std::to_string(finite) + " particles"
+                                           : std::to_string(sample.positions.size()) + " sampled of " +
+                                                 std::to_string(finite) + " particles";
   if (!std::isfinite(median)) {
     e.origin = "neighbour distances of " + of + " not found within " + std::to_string(kSpacingMaxPasses) + " reads";
     return e;

@@ -8,7 +8,9 @@
 //  - metadata (ParticleSource::spacingHint(), nothing read): OpenVDB points grids, the volume of
 //    the active voxels over the points they hold, i.e. voxelSize / cbrt(points per active voxel);
 //  - neighbours (any source): a uniform random sample of up to kSpacingSample finite particles
-//    (reservoir sampling, Li's algorithm L, with a fixed seed: deterministic); for each sampled
+//    (reservoir sampling, Li's algorithm L, with a fixed seed: deterministic; from a source that
+//    seeks to a particle, ParticleSource::readPositionsAt, drawn by number among all its
+//    particles, the non-finite ones drawn then dropped); for each sampled
 //    particle, the distance r to its kSpacingNeighbour-th nearest neighbour among all the source's particles
 //    (exact, not among the sample only); spacing = median(r) * cbrt(4 pi / (3 k)), the spacing at
 //    which a ball of radius r holds k particles. Within about 2 % of s on a cubic lattice
@@ -21,11 +23,11 @@
 // finite particles, when the median neighbour distance is 0 (coincident particles), or when it is
 // not found within kSpacingMaxPasses reads of the source.
 // Cost of the neighbour estimate: one read of the source when it has at most kSpacingSample
-// particles, else two (rarely more); memory O(kSpacingSample) plus one chunk of particles, plus
-// at most about 100 MiB, whatever the frame's size, for the search's cells near the sample (30
-// MiB on the frames measured): 4 MiB of bits and, per cell within the search radius of a
-// sampled particle (at most 216 each), the list of those particles. The source is rewound
-// afterwards.
+// particles or seeks to a particle (raw, binary PLY: the sample costs kSpacingSample small
+// reads, asked of the disk all at once), else two (rarely more); memory O(kSpacingSample) plus one chunk of particles,
+// plus at most about 100 MiB, whatever the frame's size, for the search's cells near the sample (30 MiB on the frames
+// measured): 4 MiB of bits and, per cell within the search radius of a sampled particle (at most 216 each), the list of
+// those particles. The source is rewound afterwards.
 #pragma once
 
 #include <cstddef>

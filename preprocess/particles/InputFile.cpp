@@ -47,6 +47,10 @@ class FileByteSource final : public ByteSource {
     }
     return done;
   }
+  bool randomAccess() const override { return true; }
+  void willRead(std::span<const std::uint64_t> offsets, std::size_t bytes) override {
+    for (std::uint64_t offset : offsets) ::posix_fadvise(mFd, off_t(offset), off_t(bytes), POSIX_FADV_WILLNEED);
+  }
 
  private:
   std::filesystem::path mPath;
@@ -64,6 +68,7 @@ class MemoryByteSource final : public ByteSource {
     if (n) std::memcpy(data, mBytes.data() + offset, n);
     return n;
   }
+  bool randomAccess() const override { return true; }
 
  private:
   std::span<const std::byte> mBytes;
@@ -123,6 +128,16 @@ void InputFile::readExact(void* data, std::size_t bytes, const char* what) {
   if (read(data, bytes) != bytes)
     throw FileError(mPath, std::string("truncated: the file ends inside ") + what + " (" + std::to_string(bytes) +
                                " bytes at byte " + std::to_string(at) + ", file size " + std::to_string(mSize) + ")");
+}
+
+bool InputFile::readScattered(std::span<const std::uint64_t> offsets, std::size_t bytes, std::byte* data) {
+  if (!mSource->randomAccess()) return false;
+  mSource->willRead(offsets, bytes);
+  for (std::size_t i = 0; i < offsets.size(); ++i)
+    if (mSource->readAt(offsets[i], data + i * bytes, bytes) != bytes)
+      throw FileError(mPath, "file ends before byte " + std::to_string(offsets[i] + bytes) +
+                                 " (was it truncated while being read?)");
+  return true;
 }
 
 std::vector<std::byte> InputFile::peekHead(std::size_t bytes) {

@@ -26,6 +26,11 @@ class ByteSource {
   /// decode again from its start, or from the last index point, to go back. Throws FileError
   /// on I/O errors and on damaged compressed data.
   virtual std::size_t readAt(std::uint64_t offset, void* data, std::size_t bytes) = 0;
+  /// Whether readAt costs the same at any offset (a file, memory); a decoder's does not.
+  virtual bool randomAccess() const { return false; }
+  /// A hint that the ranges of `bytes` bytes at `offsets` will be read soon: a file asks the
+  /// kernel for all of them at once, so that an uncached disk serves them in parallel.
+  virtual void willRead(std::span<const std::uint64_t> offsets, std::size_t bytes) { (void)offsets, (void)bytes; }
 };
 
 class InputFile {
@@ -61,6 +66,11 @@ class InputFile {
   bool lineTerminated() const { return mLineTerminated; }
   /// Unbuffered random access (readers that seek, e.g. OpenVDB's pages): ByteSource::readAt.
   std::size_t readAt(std::uint64_t offset, void* data, std::size_t bytes) { return mSource->readAt(offset, data, bytes); }
+  /// Reads `bytes` bytes at each of `offsets` (ascending) into `data`, one range after the other,
+  /// without moving the offset: records sampled from across the file without reading it whole.
+  /// Returns false, reading nothing, where that is no cheaper than reading the file whole (a
+  /// decoder: ByteSource::randomAccess). Throws FileError for a range past the end.
+  bool readScattered(std::span<const std::uint64_t> offsets, std::size_t bytes, std::byte* data);
   /// Up to `bytes` bytes from the start of the file, without moving the offset (format
   /// detection by magic bytes).
   std::vector<std::byte> peekHead(std::size_t bytes);

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -86,6 +87,16 @@ class ParticleSource {
   virtual bool read(ParticleChunk& chunk, std::size_t maxParticles) = 0;
   /// Starts over from the first particle (multi-pass conversion: bounds, then binning).
   virtual void rewind() = 0;
+  /// Random access, for sampling a frame without reading it whole (ParticleSpacing.h): the
+  /// positions of the particles numbered `indices` (ascending, each < countHint()) into
+  /// `positions` (resized to match), leaving the next read() where it was. Returns false,
+  /// reading nothing, unless the source seeks to a particle cheaply (fixed-size records in an
+  /// uncompressed file: raw, binary PLY); callers then read the source in order. Throws
+  /// FileError like read().
+  virtual bool readPositionsAt(std::span<const std::uint64_t> indices, std::vector<glm::vec3>& positions) {
+    (void)indices, (void)positions;
+    return false;
+  }
   /// The particle spacing as the file's metadata tells it without reading the particles, else
   /// nullopt (then estimateParticleSpacing() measures neighbour distances).
   virtual std::optional<SpacingHint> spacingHint() const { return std::nullopt; }

@@ -309,6 +309,22 @@ class PlyReader final : public ParticleSource {
     mFile.seek(mHeader.dataOffset);
     mNext = 0;
   }
+  bool readPositionsAt(std::span<const std::uint64_t> indices, std::vector<glm::vec3>& positions) override {
+    if (mHeader.encoding == PlyEncoding::Ascii) return false;  // lines of any length
+    const std::size_t stride = mHeader.vertexBytes;
+    std::vector<std::uint64_t> offsets(indices.size());
+    for (std::size_t i = 0; i < indices.size(); ++i) {
+      FLIPSCOPE_CHECK(indices[i] < mHeader.vertexCount);
+      offsets[i] = mHeader.dataOffset + indices[i] * stride;
+    }
+    std::vector<std::byte> records(indices.size() * stride);
+    if (!mFile.readScattered(offsets, stride, records.data())) return false;
+    positions.resize(indices.size());
+    for (std::size_t k = 0; k < indices.size(); ++k)
+      for (int c = 0; c < 3; ++c)
+        positions[k][c] = mDecoders[c](records.data() + k * stride + mHeader.vertexProperties[*mFields[c]].offset);
+    return true;
+  }
 
  private:
   FileError truncated(std::uint64_t particle) const {

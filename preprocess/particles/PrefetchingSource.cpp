@@ -90,4 +90,10 @@ void PrefetchingSource::rewind() {
   mEnded = false;
 }
 
+bool PrefetchingSource::readPositionsAt(std::span<const std::uint64_t> indices, std::vector<glm::vec3>& positions) {
+  std::unique_lock lock(mMutex);
+  if (mInFlight) waitForChunk(lock);
+  return mInner.readPositionsAt(indices, positions);
+}
+
 }  // namespace flipscope

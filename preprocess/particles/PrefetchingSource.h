@@ -38,6 +38,8 @@ class PrefetchingSource final : public ParticleSource {
   UpAxis upAxis() const override { return mInner.upAxis(); }
   bool read(ParticleChunk& chunk, std::size_t maxParticles) override;
   void rewind() override;
+  /// The inner source's, once the read in flight (if any) is done; a chunk read ahead stays.
+  bool readPositionsAt(std::span<const std::uint64_t> indices, std::vector<glm::vec3>& positions) override;
 
  private:
   void prefetch();

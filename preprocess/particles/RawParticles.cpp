@@ -45,6 +45,17 @@ class RawReader final : public ParticleSource {
     mFile.seek(0);
     mNext = 0;
   }
+  bool readPositionsAt(std::span<const std::uint64_t> indices, std::vector<glm::vec3>& positions) override {
+    std::vector<std::uint64_t> offsets(indices.size());
+    for (std::size_t i = 0; i < indices.size(); ++i) {
+      FLIPSCOPE_CHECK(indices[i] < mCount);
+      offsets[i] = indices[i] * kRawParticleBytes;
+    }
+    std::vector<glm::vec3> read(indices.size());
+    if (!mFile.readScattered(offsets, kRawParticleBytes, reinterpret_cast<std::byte*>(read.data()))) return false;
+    positions = std::move(read);
+    return true;
+  }
 
  private:
   InputFile mFile;

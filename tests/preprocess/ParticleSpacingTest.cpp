@@ -175,6 +175,59 @@ TEST(ParticleSpacing, SampledEstimateSkipsNonFiniteParticles) {
   EXPECT_EQ(neighbourSpacing(source, 2000).spacing, e.spacing) << "deterministic";
 }
 
+TEST(ParticleSpacing, ASampleByNumberSavesARead) {
+  // A source that seeks to a particle: its sample is drawn by number, and one read of it finds
+  // the neighbours, the count and the bounds. Without non-finite particles, the numbers drawn
+  // are those of the reservoir over a whole read: the same estimate.
+  auto points = lattice(40, 0.5f, 0.5f);
+  testing::VectorSource seeking(points), reading(points);
+  seeking.seeks = true;
+  const SpacingEstimate bySeeking = neighbourSpacing(seeking, 2000);
+  const SpacingEstimate byReading = neighbourSpacing(reading, 2000);
+  ASSERT_TRUE(bySeeking.known()) << bySeeking.origin;
+  EXPECT_EQ(bySeeking.spacing, byReading.spacing);
+  EXPECT_EQ(bySeeking.origin, byReading.origin);
+  EXPECT_EQ(seeking.particlesRead, points.size());
+  EXPECT_EQ(reading.particlesRead, 2 * points.size());
+  ASSERT_TRUE(bySeeking.bounds && byReading.bounds);
+  EXPECT_EQ(bySeeking.bounds->min, byReading.bounds->min);
+  EXPECT_EQ(bySeeking.bounds->max, byReading.bounds->max);
+
+  // Every 7th particle NaN or infinite: those drawn are dropped from the sample; the count and
+  // bounds are of the finite particles.
+  std::size_t bad = 0;
+  Box finite;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (i % 7 == 3) {
+      points[i] = i % 2 ? glm::vec3(std::numeric_limits<float>::quiet_NaN())
+                        : glm::vec3(0, std::numeric_limits<float>::infinity(), 0);
+      ++bad;
+    } else {
+      finite.extend(glm::dvec3(points[i]));
+    }
+  testing::VectorSource holey(points);
+  holey.seeks = true;
+  const SpacingEstimate e = neighbourSpacing(holey, 2000);
+  ASSERT_TRUE(e.known()) << e.origin;
+  EXPECT_NEAR(e.spacing, 0.5 * std::cbrt(7.0 / 6.0), 0.05 * 0.5) << e.origin;
+  EXPECT_NE(e.origin.find(" sampled of " + std::to_string(points.size() - bad) + " particles"), std::string::npos)
+      << e.origin;
+  EXPECT_EQ(e.origin.find("2000 sampled"), std::string::npos) << e.origin << ": the non-finite ones drawn are dropped";
+  EXPECT_EQ(holey.particlesRead, points.size());
+  ASSERT_TRUE(e.bounds);
+  EXPECT_EQ(e.bounds->min, finite.min);
+  EXPECT_EQ(e.bounds->max, finite.max);
+
+  // Too few finite particles among those drawn: the sample of a whole read instead.
+  auto sparse = lattice(40, 0.5f, 0.5f);
+  for (std::size_t i = 0; i < sparse.size(); ++i)
+    if (i % 500) sparse[i] = glm::vec3(std::numeric_limits<float>::quiet_NaN());
+  testing::VectorSource few(sparse);
+  few.seeks = true;
+  const SpacingEstimate fallback = neighbourSpacing(few, 2000);
+  EXPECT_NE(fallback.origin.find("all 128 particles"), std::string::npos) << fallback.origin;
+}
+
 TEST(ParticleSpacing, FarApartClustersGiveTheSameSpacingAsOne) {
   // Two sampled lattices far apart: the grid of query cells spans more cells than are indexed
   // directly, so the cells are hashed, and candidates are turned away by a bit per cell (500

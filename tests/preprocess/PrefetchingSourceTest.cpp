@@ -62,6 +62,22 @@ class FailingSource : public testing::VectorSource {
   std::chrono::milliseconds mDelay;
 };
 
+TEST(PrefetchingSource, RandomAccessIsTheInnerSourcesAndKeepsTheChunkReadAhead) {
+  const auto positions = testing::randomParticles(1000, 7);
+  testing::VectorSource inner(positions);
+  PrefetchingSource ahead(inner);
+  const std::vector<std::uint64_t> some{3, 500, 999};
+  std::vector<glm::vec3> picked;
+  EXPECT_FALSE(ahead.readPositionsAt(some, picked)) << "the inner source declines";
+  inner.seeks = true;
+  ParticleChunk chunk;
+  ASSERT_TRUE(ahead.read(chunk, 100));  // and the next chunk is in flight
+  ASSERT_TRUE(ahead.readPositionsAt(some, picked));
+  EXPECT_EQ(picked, (std::vector<glm::vec3>{positions[3], positions[500], positions[999]}));
+  ASSERT_TRUE(ahead.read(chunk, 100));
+  EXPECT_EQ(chunk.positions.front(), positions[100]);
+}
+
 TEST(PrefetchingSource, TheInnerSourcesErrorReachesTheCaller) {
   FailingSource inner(testing::randomParticles(1000, 4), std::chrono::milliseconds(0));
   PrefetchingSource ahead(inner);

@@ -26,9 +26,18 @@ class VectorSource : public ParticleSource {
     chunk.positions.assign(mPositions.begin() + mNext, mPositions.begin() + mNext + n);
     if (!mVelocities.empty()) chunk.velocities.assign(mVelocities.begin() + mNext, mVelocities.begin() + mNext + n);
     mNext += n;
+    particlesRead += n;
     return n > 0;
   }
   void rewind() override { mNext = 0; }
+  bool seeks = false;               ///< whether readPositionsAt() reads (else it declines, like a decoder)
+  std::uint64_t particlesRead = 0;  ///< by read()
+  bool readPositionsAt(std::span<const std::uint64_t> indices, std::vector<glm::vec3>& positions) override {
+    if (!seeks) return false;
+    positions.clear();
+    for (std::uint64_t i : indices) positions.push_back(mPositions.at(i));
+    return true;
+  }
 
  private:
   std::vector<glm::vec3> mPositions, mVelocities;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "GzipTestWriter.h"
 #include "ParticleTestSupport.h"
 
 namespace flipscope {
@@ -14,6 +15,7 @@ namespace {
 using testing::expectFileError;
 using testing::randomParticles;
 using testing::readAll;
+using testing::readBytes;
 using testing::readFile;
 using testing::sameBits;
 using testing::TempDir;
@@ -121,6 +123,16 @@ TEST(PlyReader, EveryScalarTypeAndEncodingAgainstEncoder) {
             float got = f < 3 ? read.positions[r][int(f)] : read.velocities[r][int(f - 3)];
             ASSERT_EQ(got, float(rows[r][c])) << format << " " << columns[c].type << " " << fields[f] << " row " << r;
           }
+    // Random access to every other particle and the last one: binary files only.
+    std::vector<std::uint64_t> some;
+    for (std::uint64_t r = 0; r < rows.size(); r += 2) some.push_back(r);
+    if (some.back() + 1 != rows.size()) some.push_back(rows.size() - 1);
+    std::vector<glm::vec3> picked;
+    ASSERT_EQ(source->readPositionsAt(some, picked), format != "ascii") << format;
+    if (format == "ascii") continue;
+    ASSERT_EQ(picked.size(), some.size());
+    for (std::size_t i = 0; i < some.size(); ++i)
+      ASSERT_EQ(picked[i], read.positions[some[i]]) << format << " particle " << some[i];
   }
 }
 
@@ -233,6 +245,33 @@ std::vector<std::filesystem::path> writeEveryFormat(const TempDir& dir, const Pa
     writeFile(paths.back(), particles, options);
   }
   return paths;
+}
+
+TEST(ParticleSource, RandomAccessGivesTheParticlesOfAReadAndLeavesTheReadWhereItWas) {
+  TempDir dir("random-access");
+  const std::vector<std::uint64_t> some{0, 1, 17, 600, 899};
+  std::size_t seeking = 0;
+  for (const auto& path : writeEveryFormat(dir, randomParticles(900, true, 33))) {
+    auto source = openParticleFile(path);
+    const ParticleChunk reference = readAll(*source, 1 << 20);
+    source->rewind();
+    ParticleChunk chunk;
+    ASSERT_TRUE(source->read(chunk, 100));
+    std::vector<glm::vec3> picked;
+    if (source->readPositionsAt(some, picked)) {
+      ++seeking;
+      ASSERT_EQ(picked.size(), some.size()) << path;
+      for (std::size_t i = 0; i < some.size(); ++i)
+        EXPECT_TRUE(sameBits(picked[i], reference.positions[some[i]])) << path;
+    }
+    ASSERT_TRUE(source->read(chunk, 100));
+    EXPECT_TRUE(sameBits(chunk.positions[0], reference.positions[100])) << path << ": the read moved";
+    // Compressed, the same particles are no cheaper to reach than by reading: no random access.
+    if (path.extension() != ".ply") continue;
+    writeBytes(dir / "packed.ply.gz", testing::gzip(readBytes(path)));
+    EXPECT_FALSE(openParticleFile(dir / "packed.ply.gz")->readPositionsAt(some, picked));
+  }
+  EXPECT_EQ(seeking, 2u) << "raw and binary PLY seek to a particle";
 }
 
 TEST(ParticleSource, ChunkSizeDoesNotChangeTheParticles) {
