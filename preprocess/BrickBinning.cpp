@@ -173,7 +173,10 @@ std::uint16_t quantizeAttribute(float s, float min, float max) {
   const float t = (s - min) / (max - min);
   if (!(t > 0.0f)) return 0;
   if (!(t < 1.0f)) return 65535;
-  return std::uint16_t(std::lround(t * 65535.0f));
+  // std::lround without the library call (a third of the quantizing pass): x - floor(x) is
+  // exact for 0 < x < 2^23.
+  const float x = t * 65535.0f, whole = std::floor(x);
+  return std::uint16_t(std::uint16_t(whole) + (x - whole >= 0.5f ? 1 : 0));
 }
 
 void makeBinningKeys(KeyBatch& batch, const KeyGrid& grid, float min, float max) {
@@ -281,12 +284,22 @@ struct BrickParts {
   }
 };
 
+/// What decodeRun reuses from one brick to the next (one a thread).
+struct DecodeScratch {
+  std::vector<std::uint32_t> histogram;  ///< per cell of a dense brick: its keys, then its first attribute slot
+  std::vector<ParticleKind> cellKinds;   ///< per cell of a dense brick
+  std::vector<std::uint64_t> gathered;   ///< the keys of a sparse brick of several runs
+  UninitializedVector<std::uint32_t> cells, counts;  ///< a dense brick's occupied cells, written without a branch
+};
+
 /// Encodes one brick's keys (same brick code, any order, in the runs of `parts` of `all`) into
 /// `out` (reuses its vectors); with `kinds`, a cell's kind is the smallest of its keys' (the key
-/// layout of binningKey). `gathered` holds the keys of a sparse brick of several runs.
+/// layout of binningKey).
 void decodeRun(std::uint64_t* all, const BrickParts& parts, const KeyGrid& grid, bool attribute, bool kinds,
-               DecodedBrick& out, std::vector<std::uint32_t>& histogram, std::vector<ParticleKind>& cellKinds,
-               std::vector<std::uint64_t>& gathered) {
+               DecodedBrick& out, DecodeScratch& scratch) {
+  std::vector<std::uint32_t>& histogram = scratch.histogram;
+  std::vector<ParticleKind>& cellKinds = scratch.cellKinds;
+  std::vector<std::uint64_t>& gathered = scratch.gathered;
   out.cells.clear();
   out.counts.clear();
   out.attributes.clear();
@@ -334,23 +347,38 @@ void decodeRun(std::uint64_t* all, const BrickParts& parts, const KeyGrid& grid,
     cellKinds.assign(cellsPerBrick, ParticleKind(kParticleKindCount - 1));
     forEachKey([&](std::uint64_t k) { cellKinds[cellOf(k)] = std::min(cellKinds[cellOf(k)], kindOf(k)); });
   }
-  std::uint32_t offset = 0;
+  // The occupied cells, without a branch on each (about half of a liquid brick's are empty).
+  scratch.cells.resize(cellsPerBrick);
+  scratch.counts.resize(cellsPerBrick);
+  std::uint32_t offset = 0, occupied = 0;
   for (std::uint32_t c = 0; c < cellsPerBrick; ++c) {
-    if (!histogram[c]) continue;
-    out.cells.push_back(c);
-    out.counts.push_back(histogram[c]);
-    if (kinds) out.kinds.push_back(cellKinds[c]);
     const std::uint32_t count = histogram[c];
+    scratch.cells[occupied] = c;
+    scratch.counts[occupied] = count;
     histogram[c] = offset;  // becomes the cell's first attribute slot
     offset += count;
+    occupied += count != 0;
   }
+  out.cells.assign(scratch.cells.begin(), scratch.cells.begin() + occupied);
+  out.counts.assign(scratch.counts.begin(), scratch.counts.begin() + occupied);
+  if (kinds)
+    for (std::uint32_t c : out.cells) out.kinds.push_back(cellKinds[c]);
   if (!attribute) return;
   out.attributes.resize(total);
   forEachKey([&](std::uint64_t k) { out.attributes[histogram[cellOf(k)]++] = attributeOf(k); });
-  std::size_t start = 0;
+  std::uint16_t* cellValues = out.attributes.data();
   for (auto count : out.counts) {
-    std::sort(out.attributes.begin() + start, out.attributes.begin() + start + count);
-    start += count;
+    if (count <= 16) {  // a cell's few values: an insertion sort, no call
+      for (std::uint32_t i = 1; i < count; ++i) {
+        const std::uint16_t v = cellValues[i];
+        std::uint32_t j = i;
+        for (; j > 0 && cellValues[j - 1] > v; --j) cellValues[j] = cellValues[j - 1];
+        cellValues[j] = v;
+      }
+    } else {
+      std::sort(cellValues, cellValues + count);
+    }
+    cellValues += count;
   }
 }
 
@@ -393,10 +421,8 @@ void binKeys(std::span<std::uint64_t> keys, const KeyGrid& grid, int zstdLevel,
     tbb::parallel_for(std::size_t(0), count, [&](std::size_t i) {
       const BrickParts& parts = bricks[first + i];
       thread_local DecodedBrick brick;
-      thread_local std::vector<std::uint32_t> histogram;
-      thread_local std::vector<ParticleKind> cellKinds;
-      thread_local std::vector<std::uint64_t> gathered;
-      decodeRun(keys.data(), parts, grid, attribute, kinds, brick, histogram, cellKinds, gathered);
+      thread_local DecodeScratch scratch;
+      decodeRun(keys.data(), parts, grid, attribute, kinds, brick, scratch);
       EncodedBrick& e = batch[i];
       for (ParticleKind kind : brick.kinds) ++e.kindCells[std::size_t(kind)];
       e.coord = glm::uvec3(mortonDecode3(std::uint32_t(parts.code)));
