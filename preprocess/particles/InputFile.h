@@ -26,7 +26,8 @@ class ByteSource {
   /// decode again from its start, or from the last index point, to go back. Throws FileError
   /// on I/O errors and on damaged compressed data.
   virtual std::size_t readAt(std::uint64_t offset, void* data, std::size_t bytes) = 0;
-  /// Whether readAt costs the same at any offset (a file, memory); a decoder's does not.
+  /// Whether readAt costs the same at any offset (a file, memory); a decoder's does not. Such
+  /// a source's readAt may be called from two threads at once.
   virtual bool randomAccess() const { return false; }
   /// A hint that the ranges of `bytes` bytes at `offsets` will be read soon: a file asks the
   /// kernel for all of them at once, so that an uncached disk serves them in parallel.
@@ -64,6 +65,9 @@ class InputFile {
   bool readLine(std::string& line, std::size_t maxLength);
   /// Whether the line readLine() returned last ended with "\n" (false: the file ended inside it).
   bool lineTerminated() const { return mLineTerminated; }
+  /// Whether random access is cheap: ByteSource::randomAccess. Then readAt and readScattered may
+  /// be called from several threads at once.
+  bool randomAccess() const { return mSource->randomAccess(); }
   /// Unbuffered random access (readers that seek, e.g. OpenVDB's pages): ByteSource::readAt.
   std::size_t readAt(std::uint64_t offset, void* data, std::size_t bytes) { return mSource->readAt(offset, data, bytes); }
   /// Reads `bytes` bytes at each of `offsets` (ascending) into `data`, one range after the other,

@@ -97,6 +97,16 @@ class ParticleSource {
     (void)indices, (void)positions;
     return false;
   }
+  /// Random access by range, for reading a frame on several threads at once (ParticleSpacing.h):
+  /// the positions of particles [first, first + count) (within countHint()) into `positions`
+  /// (resized to match), leaving the next read() where it was. Thread safe: calls may overlap
+  /// each other and one read() or readPositionsAt(). Returns false, reading nothing, unless the
+  /// source seeks to a particle cheaply (as readPositionsAt); a source that reads ranges does
+  /// so for count 0 too. Throws FileError like read().
+  virtual bool readPositionRange(std::uint64_t first, std::size_t count, std::vector<glm::vec3>& positions) {
+    (void)first, (void)count, (void)positions;
+    return false;
+  }
   /// The particle spacing as the file's metadata tells it without reading the particles, else
   /// nullopt (then estimateParticleSpacing() measures neighbour distances).
   virtual std::optional<SpacingHint> spacingHint() const { return std::nullopt; }

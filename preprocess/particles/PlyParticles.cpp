@@ -320,9 +320,19 @@ class PlyReader final : public ParticleSource {
     std::vector<std::byte> records(indices.size() * stride);
     if (!mFile.readScattered(offsets, stride, records.data())) return false;
     positions.resize(indices.size());
-    for (std::size_t k = 0; k < indices.size(); ++k)
-      for (int c = 0; c < 3; ++c)
-        positions[k][c] = mDecoders[c](records.data() + k * stride + mHeader.vertexProperties[*mFields[c]].offset);
+    splitRecords(records.data(), indices.size(), positions.data(), nullptr);
+    return true;
+  }
+  bool readPositionRange(std::uint64_t first, std::size_t count, std::vector<glm::vec3>& positions) override {
+    if (mHeader.encoding == PlyEncoding::Ascii || !mFile.randomAccess()) return false;
+    FLIPSCOPE_CHECK(first + count <= mHeader.vertexCount);
+    const std::size_t stride = mHeader.vertexBytes;
+    thread_local std::vector<std::byte> records;  // (each thread's, kept: no fresh pages a range)
+    records.resize(count * stride);
+    const std::size_t got = mFile.readAt(mHeader.dataOffset + first * stride, records.data(), records.size());
+    if (got != records.size()) throw truncated(first + got / stride);
+    positions.resize(count);
+    splitRecords(records.data(), count, positions.data(), nullptr);
     return true;
   }
 
@@ -340,42 +350,50 @@ class PlyReader final : public ParticleSource {
     mBuffer.resize(n * stride);
     std::size_t got = mFile.read(mBuffer.data(), mBuffer.size());
     if (got != mBuffer.size()) throw truncated(mNext + got / stride);
-    std::size_t offsets[6] = {};
-    for (int i = 0; i < 6; ++i)
-      if (mFields[i]) offsets[i] = mHeader.vertexProperties[*mFields[i]].offset;
-    // The common case, little-endian float32 fields, is plain copies (no call a value).
-    bool plainFloats = mHeader.encoding == PlyEncoding::BinaryLittleEndian;
-    for (int i = 0; i < (mHasVelocity ? 6 : 3); ++i)
-      plainFloats = plainFloats && mHeader.vertexProperties[*mFields[i]].type == PlyType::Float32;
-    // Most writers put x, y, z (and vx, vy, vz) side by side: one 12-byte copy each.
-    const bool sideBySide = offsets[1] == offsets[0] + 4 && offsets[2] == offsets[0] + 8 &&
-                            (!mHasVelocity || (offsets[4] == offsets[3] + 4 && offsets[5] == offsets[3] + 8));
-    if (plainFloats && sideBySide) {
-      const std::byte* record = mBuffer.data();
-      for (std::uint64_t k = 0; k < n; ++k, record += stride) {
-        std::memcpy(&chunk.positions[k], record + offsets[0], sizeof(glm::vec3));
-        if (mHasVelocity) std::memcpy(&chunk.velocities[k], record + offsets[3], sizeof(glm::vec3));
-      }
-    } else if (plainFloats) {
-      for (std::uint64_t k = 0; k < n; ++k) {
-        const std::byte* record = mBuffer.data() + k * stride;
-        for (int c = 0; c < 3; ++c) std::memcpy(&chunk.positions[k][c], record + offsets[c], 4);
-        if (mHasVelocity)
-          for (int c = 0; c < 3; ++c) std::memcpy(&chunk.velocities[k][c], record + offsets[3 + c], 4);
-      }
-    } else {
-      for (std::uint64_t k = 0; k < n; ++k) {
-        const std::byte* record = mBuffer.data() + k * stride;
-        for (int c = 0; c < 3; ++c) chunk.positions[k][c] = mDecoders[c](record + offsets[c]);
-        if (mHasVelocity)
-          for (int c = 0; c < 3; ++c) chunk.velocities[k][c] = mDecoders[3 + c](record + offsets[3 + c]);
-      }
-    }
+    splitRecords(mBuffer.data(), n, chunk.positions.data(), mHasVelocity ? chunk.velocities.data() : nullptr);
     for (std::size_t a = 0; a < mSelected.size(); ++a) {
       const std::size_t offset = mHeader.vertexProperties[mSelected[a]].offset;
       const BinaryDecoder decode = mSelectedDecoders[a];
       float* out = chunk.attributes[a].values.data();
       for (std::uint64_t k = 0; k < n; ++k) out[k] = decode(mBuffer.data() + k * stride + offset);
+    }
+  }
+
+  /// The positions (and, where `velocities` is given, the velocities) of `n` binary records
+  /// that lie one after the other at `records`. Thread safe.
+  void splitRecords(const std::byte* records, std::uint64_t n, glm::vec3* positions, glm::vec3* velocities) const {
+    const std::size_t stride = mHeader.vertexBytes;
+    const bool velocity = velocities != nullptr;
+    std::size_t offsets[6] = {};
+    for (int i = 0; i < 6; ++i)
+      if (mFields[i]) offsets[i] = mHeader.vertexProperties[*mFields[i]].offset;
+    // The common case, little-endian float32 fields, is plain copies (no call a value).
+    bool plainFloats = mHeader.encoding == PlyEncoding::BinaryLittleEndian;
+    for (int i = 0; i < (velocity ? 6 : 3); ++i)
+      plainFloats = plainFloats && mHeader.vertexProperties[*mFields[i]].type == PlyType::Float32;
+    // Most writers put x, y, z (and vx, vy, vz) side by side: one 12-byte copy each.
+    const bool sideBySide = offsets[1] == offsets[0] + 4 && offsets[2] == offsets[0] + 8 &&
+                            (!velocity || (offsets[4] == offsets[3] + 4 && offsets[5] == offsets[3] + 8));
+    if (plainFloats && sideBySide) {
+      const std::byte* record = records;
+      for (std::uint64_t k = 0; k < n; ++k, record += stride) {
+        std::memcpy(&positions[k], record + offsets[0], sizeof(glm::vec3));
+        if (velocity) std::memcpy(&velocities[k], record + offsets[3], sizeof(glm::vec3));
+      }
+    } else if (plainFloats) {
+      for (std::uint64_t k = 0; k < n; ++k) {
+        const std::byte* record = records + k * stride;
+        for (int c = 0; c < 3; ++c) std::memcpy(&positions[k][c], record + offsets[c], 4);
+        if (velocity)
+          for (int c = 0; c < 3; ++c) std::memcpy(&velocities[k][c], record + offsets[3 + c], 4);
+      }
+    } else {
+      for (std::uint64_t k = 0; k < n; ++k) {
+        const std::byte* record = records + k * stride;
+        for (int c = 0; c < 3; ++c) positions[k][c] = mDecoders[c](record + offsets[c]);
+        if (velocity)
+          for (int c = 0; c < 3; ++c) velocities[k][c] = mDecoders[3 + c](record + offsets[3 + c]);
+      }
     }
   }
 

@@ -40,6 +40,10 @@ class PrefetchingSource final : public ParticleSource {
   void rewind() override;
   /// The inner source's, once the read in flight (if any) is done; a chunk read ahead stays.
   bool readPositionsAt(std::span<const std::uint64_t> indices, std::vector<glm::vec3>& positions) override;
+  /// The inner source's (thread safe, it leaves the reads where they are).
+  bool readPositionRange(std::uint64_t first, std::size_t count, std::vector<glm::vec3>& positions) override {
+    return mInner.readPositionRange(first, count, positions);
+  }
 
  private:
   void prefetch();

@@ -56,6 +56,17 @@ class RawReader final : public ParticleSource {
     positions = std::move(read);
     return true;
   }
+  bool readPositionRange(std::uint64_t first, std::size_t count, std::vector<glm::vec3>& positions) override {
+    if (!mFile.randomAccess()) return false;
+    FLIPSCOPE_CHECK(first + count <= mCount);
+    positions.resize(count);
+    const std::size_t bytes = count * kRawParticleBytes;
+    if (mFile.readAt(first * kRawParticleBytes, positions.data(), bytes) != bytes)
+      throw FileError(mFile.path(), "file ends inside particles " + std::to_string(first) + " to " +
+                                        std::to_string(first + count) + " of " + std::to_string(mCount) +
+                                        " (was it truncated while being read?)");
+    return true;
+  }
 
  private:
   InputFile mFile;

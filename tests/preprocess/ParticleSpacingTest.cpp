@@ -176,9 +176,9 @@ TEST(ParticleSpacing, SampledEstimateSkipsNonFiniteParticles) {
 }
 
 TEST(ParticleSpacing, ASampleByNumberSavesARead) {
-  // A source that seeks to a particle: its sample is drawn by number, and one read of it finds
-  // the neighbours, the count and the bounds. Without non-finite particles, the numbers drawn
-  // are those of the reservoir over a whole read: the same estimate.
+  // A source that seeks to a particle: its sample is drawn by number, and one read of it, by
+  // ranges on every core, finds the neighbours, the count and the bounds. Without non-finite
+  // particles, the numbers drawn are those of the reservoir over a whole read: the same estimate.
   auto points = lattice(40, 0.5f, 0.5f);
   testing::VectorSource seeking(points), reading(points);
   seeking.seeks = true;
@@ -187,7 +187,8 @@ TEST(ParticleSpacing, ASampleByNumberSavesARead) {
   ASSERT_TRUE(bySeeking.known()) << bySeeking.origin;
   EXPECT_EQ(bySeeking.spacing, byReading.spacing);
   EXPECT_EQ(bySeeking.origin, byReading.origin);
-  EXPECT_EQ(seeking.particlesRead, points.size());
+  EXPECT_EQ(seeking.particlesRead, 0u);
+  EXPECT_EQ(seeking.particlesInRanges, points.size());
   EXPECT_EQ(reading.particlesRead, 2 * points.size());
   ASSERT_TRUE(bySeeking.bounds && byReading.bounds);
   EXPECT_EQ(bySeeking.bounds->min, byReading.bounds->min);
@@ -213,7 +214,7 @@ TEST(ParticleSpacing, ASampleByNumberSavesARead) {
   EXPECT_NE(e.origin.find(" sampled of " + std::to_string(points.size() - bad) + " particles"), std::string::npos)
       << e.origin;
   EXPECT_EQ(e.origin.find("2000 sampled"), std::string::npos) << e.origin << ": the non-finite ones drawn are dropped";
-  EXPECT_EQ(holey.particlesRead, points.size());
+  EXPECT_EQ(holey.particlesInRanges, points.size());
   ASSERT_TRUE(e.bounds);
   EXPECT_EQ(e.bounds->min, finite.min);
   EXPECT_EQ(e.bounds->max, finite.max);

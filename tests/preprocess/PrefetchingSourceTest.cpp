@@ -74,6 +74,8 @@ TEST(PrefetchingSource, RandomAccessIsTheInnerSourcesAndKeepsTheChunkReadAhead) 
   ASSERT_TRUE(ahead.read(chunk, 100));  // and the next chunk is in flight
   ASSERT_TRUE(ahead.readPositionsAt(some, picked));
   EXPECT_EQ(picked, (std::vector<glm::vec3>{positions[3], positions[500], positions[999]}));
+  ASSERT_TRUE(ahead.readPositionRange(998, 2, picked));
+  EXPECT_EQ(picked, (std::vector<glm::vec3>{positions[998], positions[999]}));
   ASSERT_TRUE(ahead.read(chunk, 100));
   EXPECT_EQ(chunk.positions.front(), positions[100]);
 }

@@ -1,7 +1,9 @@
 // An in-memory ParticleSource for tests.
 #pragma once
 
+#include <atomic>
 #include <random>
+#include <stdexcept>
 
 #include <glm/common.hpp>
 
@@ -30,12 +32,20 @@ class VectorSource : public ParticleSource {
     return n > 0;
   }
   void rewind() override { mNext = 0; }
-  bool seeks = false;               ///< whether readPositionsAt() reads (else it declines, like a decoder)
-  std::uint64_t particlesRead = 0;  ///< by read()
+  bool seeks = false;  ///< whether readPositionsAt() and readPositionRange() read (else they decline, like a decoder)
+  std::uint64_t particlesRead = 0;                  ///< by read()
+  std::atomic<std::uint64_t> particlesInRanges{0};  ///< by readPositionRange()
   bool readPositionsAt(std::span<const std::uint64_t> indices, std::vector<glm::vec3>& positions) override {
     if (!seeks) return false;
     positions.clear();
     for (std::uint64_t i : indices) positions.push_back(mPositions.at(i));
+    return true;
+  }
+  bool readPositionRange(std::uint64_t first, std::size_t count, std::vector<glm::vec3>& positions) override {
+    if (!seeks) return false;
+    if (first + count > mPositions.size()) throw std::out_of_range("range beyond the particles");
+    positions.assign(mPositions.begin() + std::ptrdiff_t(first), mPositions.begin() + std::ptrdiff_t(first + count));
+    particlesInRanges += count;
     return true;
   }
 

@@ -8,6 +8,7 @@
 
 #include "GzipTestWriter.h"
 #include "ParticleTestSupport.h"
+#include "preprocess/particles/InputFile.h"
 
 namespace flipscope {
 namespace {
@@ -257,12 +258,21 @@ TEST(ParticleSource, RandomAccessGivesTheParticlesOfAReadAndLeavesTheReadWhereIt
     source->rewind();
     ParticleChunk chunk;
     ASSERT_TRUE(source->read(chunk, 100));
-    std::vector<glm::vec3> picked;
+    std::vector<glm::vec3> picked, range;
     if (source->readPositionsAt(some, picked)) {
       ++seeking;
       ASSERT_EQ(picked.size(), some.size()) << path;
       for (std::size_t i = 0; i < some.size(); ++i)
         EXPECT_TRUE(sameBits(picked[i], reference.positions[some[i]])) << path;
+      // ... and by range: particles 650 to 899, the last ones.
+      ASSERT_TRUE(source->readPositionRange(0, 0, range)) << path;
+      EXPECT_TRUE(range.empty());
+      ASSERT_TRUE(source->readPositionRange(650, 250, range)) << path;
+      ASSERT_EQ(range.size(), 250u);
+      for (std::size_t i = 0; i < range.size(); ++i)
+        EXPECT_TRUE(sameBits(range[i], reference.positions[650 + i])) << path;
+    } else {
+      EXPECT_FALSE(source->readPositionRange(0, 10, range)) << path;
     }
     ASSERT_TRUE(source->read(chunk, 100));
     EXPECT_TRUE(sameBits(chunk.positions[0], reference.positions[100])) << path << ": the read moved";
@@ -270,8 +280,27 @@ TEST(ParticleSource, RandomAccessGivesTheParticlesOfAReadAndLeavesTheReadWhereIt
     if (path.extension() != ".ply") continue;
     writeBytes(dir / "packed.ply.gz", testing::gzip(readBytes(path)));
     EXPECT_FALSE(openParticleFile(dir / "packed.ply.gz")->readPositionsAt(some, picked));
+    EXPECT_FALSE(openParticleFile(dir / "packed.ply.gz")->readPositionRange(0, 10, range));
   }
   EXPECT_EQ(seeking, 2u) << "raw and binary PLY seek to a particle";
+}
+
+TEST(InputFile, ManyScatteredReadsOnTwoThreadsGiveEveryRangeAndAShortOneNamesTheFile) {
+  TempDir dir("scattered");
+  std::string bytes(1 << 16, '\0');
+  for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = char(i % 251);
+  writeBytes(dir / "bytes.bin", bytes);
+  InputFile file(dir / "bytes.bin");
+  std::vector<std::uint64_t> offsets;  // more than one thread's share, and up to the last byte
+  for (std::uint64_t at = 0; at + 7 <= bytes.size(); at += 21) offsets.push_back(at);
+  offsets.push_back(bytes.size() - 7);
+  ASSERT_GT(offsets.size(), 2048u);
+  std::vector<std::byte> got(offsets.size() * 7);
+  ASSERT_TRUE(file.readScattered(offsets, 7, got.data()));
+  for (std::size_t i = 0; i < offsets.size(); ++i)
+    ASSERT_EQ(std::memcmp(got.data() + i * 7, bytes.data() + offsets[i], 7), 0) << "range " << i;
+  offsets.back() = bytes.size() - 3;  // ends past the file, on the second thread's share
+  expectFileError([&] { file.readScattered(offsets, 7, got.data()); }, {"bytes.bin", "file ends before byte 65540"});
 }
 
 TEST(ParticleSource, ChunkSizeDoesNotChangeTheParticles) {
