@@ -146,19 +146,20 @@ void FramePipeline::init(std::shared_ptr<BrickSource> source,
     auto& cpu = static_cast<CpuRaycaster&>(mRenderer->device());
     s.hits = static_cast<CpuScreenDevice&>(*mScreen).adoptFramePixels(
         [&cpu] {
-          const std::vector<RayHit>& hits = cpu.hits();
+          const std::span<const RayHit> hits = cpu.hits();
           return std::span<const glm::vec4>(reinterpret_cast<const glm::vec4*>(hits.data()), hits.size() * kVec4PerHit);
         },
         kVec4PerHit);
   }
-  s.rawGbuffer = mScreen->createFrameImage();
-  s.gbuffer = mScreen->createFrameImage();
-  s.sphereNormals = mScreen->createFrameImage();
-  s.smoothed = mScreen->createFrameImage();
-  s.normals = mScreen->createFrameImage();
-  s.shaded = mScreen->createFrameImage();
-  s.display = mScreen->createFrameImage();
-  s.shown = mScreen->createFrameImage();
+  const std::vector<ScreenImage> images = mScreen->createFrameImages(8);
+  s.rawGbuffer = images[0];
+  s.gbuffer = images[1];
+  s.sphereNormals = images[2];
+  s.smoothed = images[3];
+  s.normals = images[4];
+  s.shaded = images[5];
+  s.display = images[6];
+  s.shown = images[7];
   mScreen->clear(s.display);
   mScreen->clear(s.shown);
   s.filter = createSurfaceFilter(mSurface.smoothing);

@@ -129,7 +129,7 @@ void CpuRaycaster::beginImage(std::uint32_t width, std::uint32_t height) {
   mRaysFresh = true;  // the first pass writes every ray (rayAt)
 }
 
-const std::vector<RayHit>& CpuRaycaster::hits() {
+std::span<const RayHit> CpuRaycaster::hits() {
   if (mRaysFresh) std::fill(mHits.begin(), mHits.end(), RayHit{});
   mRaysFresh = false;
   return mHits;

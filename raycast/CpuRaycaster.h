@@ -29,10 +29,13 @@ class CpuRaycaster : public RaycastDevice {
   void beginImage(std::uint32_t width, std::uint32_t height) override;
   std::vector<std::uint32_t> trace(const RaycastParams& params) override;
   double lastTraceMs() const override { return mLastTraceMs; }
-  std::vector<RayHit> readHits() override { return hits(); }
+  std::vector<RayHit> readHits() override {
+    const std::span<const RayHit> h = hits();
+    return {h.begin(), h.end()};
+  }
   /// The image's rays in place, for the passes after the ray-caster (fresh pending rays before
   /// the first pass).
-  const std::vector<RayHit>& hits();
+  std::span<const RayHit> hits();
 
   /// The pool's arrays, laid out as the GPU's buffers. Slots are left uninitialized until a
   /// brick is uploaded (the page table never points at an empty slot), so a large budget costs
@@ -83,7 +86,7 @@ class CpuRaycaster : public RaycastDevice {
   RayHit rayAt(std::size_t i) const { return mRaysFresh ? RayHit{} : mHits[i]; }
 
   Pool mPool;
-  std::vector<RayHit> mHits;
+  UninitializedVector<RayHit> mHits;  ///< (the first pass writes every ray, on every core)
   bool mRaysFresh = false;  ///< mHits not yet written since beginImage
   std::uint32_t mWidth = 0, mHeight = 0;
 

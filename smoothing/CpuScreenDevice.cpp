@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <thread>
 
+#include <tbb/parallel_for.h>
+
 #include "core/Error.h"
 
 namespace flipscope {
@@ -23,6 +25,19 @@ ScreenImage CpuScreenDevice::createFrameImage(std::uint32_t perPixel) {
   FLIPSCOPE_CHECK(perPixel > 0);
   mImages.push_back({perPixel, std::vector<glm::vec4>(std::size_t(width()) * height() * perPixel, glm::vec4(0))});
   return ScreenImage(mImages.size() - 1);
+}
+
+std::vector<ScreenImage> CpuScreenDevice::createFrameImages(std::size_t count) {
+  // The zeroing is most of the cost (the kernel's first touch of the pages): on every core.
+  std::vector<std::vector<glm::vec4>> pixels(count);
+  tbb::parallel_for(std::size_t(0), count,
+                    [&](std::size_t i) { pixels[i].assign(std::size_t(width()) * height(), glm::vec4(0)); });
+  std::vector<ScreenImage> images;
+  for (auto& data : pixels) {
+    mImages.push_back({1, std::move(data)});
+    images.push_back(ScreenImage(mImages.size() - 1));
+  }
+  return images;
 }
 
 ScreenImage CpuScreenDevice::createFixedImage(std::size_t elements) {

@@ -16,6 +16,7 @@ class CpuScreenDevice : public ScreenDevice {
   std::string name() const override;
   void setFrame(const ScreenFrame& frame) override;
   ScreenImage createFrameImage(std::uint32_t perPixel = 1) override;
+  std::vector<ScreenImage> createFrameImages(std::size_t count) override;
   ScreenImage createFixedImage(std::size_t elements) override;
   void upload(ScreenImage image, std::span<const glm::vec4> data) override;
   std::vector<glm::vec4> download(ScreenImage image) override;

@@ -56,6 +56,12 @@ class ScreenDevice {
 
   /// A frame-sized image of `perPixel` vec4 per pixel.
   virtual ScreenImage createFrameImage(std::uint32_t perPixel = 1) = 0;
+  /// `count` frame-sized images of one vec4 per pixel (the CPU device zeroes them on every core).
+  virtual std::vector<ScreenImage> createFrameImages(std::size_t count) {
+    std::vector<ScreenImage> images;
+    for (std::size_t i = 0; i < count; ++i) images.push_back(createFrameImage());
+    return images;
+  }
   /// An image of `elements` vec4 that keeps its size (an environment map).
   virtual ScreenImage createFixedImage(std::size_t elements) = 0;
   /// Writes the whole image (data.size() equals its element count).

@@ -21,7 +21,7 @@ FramePipeline cpuPipeline(std::shared_ptr<BrickSource> source) {
                        SurfaceSettings{});
 }
 
-const std::vector<RayHit>& hitsOf(FramePipeline& pipeline) {
+std::span<const RayHit> hitsOf(FramePipeline& pipeline) {
   return static_cast<CpuRaycaster&>(pipeline.renderer().device()).hits();
 }
 
@@ -93,7 +93,7 @@ TEST(ProgressiveFrames, PendingRaysKeepThePreviousImage) {
   const FramePipeline::Progress p = pipeline.advance(1.0);
   ASSERT_TRUE(p.changed);
   const std::vector<glm::vec4> after = pipeline.downloadDisplay();
-  const std::vector<RayHit>& hits = hitsOf(pipeline);
+  const std::span<const RayHit> hits = hitsOf(pipeline);
   int pending = 0, finished = 0;
   for (std::size_t i = 0; i < hits.size(); ++i) {
     if (hits[i].status == kRayPending) {
