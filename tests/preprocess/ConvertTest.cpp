@@ -157,8 +157,9 @@ TEST(Convert, AttributeQuantizationByHand) {
   for (std::uint32_t step = 0; step < 65535; ++step)
     for (const float t : {(float(step) + 0.5f) / 65535.0f, std::nextafter((float(step) + 0.5f) / 65535.0f, 0.0f),
                           std::nextafter((float(step) + 0.5f) / 65535.0f, 1.0f)})
-      if (t > 0.0f && t < 1.0f)
+      if (t > 0.0f && t < 1.0f) {
         ASSERT_EQ(detail::quantizeAttribute(t, 0.0f, 1.0f), std::uint16_t(std::lround(t * 65535.0f))) << t;
+      }
 }
 
 /// Brick size and cell size of a store over [0, 50)^3, and whether its batch keys carry their
