@@ -326,13 +326,19 @@ class PlyReader final : public ParticleSource {
   bool readPositionRange(std::uint64_t first, std::size_t count, std::vector<glm::vec3>& positions) override {
     if (mHeader.encoding == PlyEncoding::Ascii || !mFile.randomAccess()) return false;
     FLIPSCOPE_CHECK(first + count <= mHeader.vertexCount);
-    const std::size_t stride = mHeader.vertexBytes;
-    thread_local std::vector<std::byte> records;  // (each thread's, kept: no fresh pages a range)
-    records.resize(count * stride);
-    const std::size_t got = mFile.readAt(mHeader.dataOffset + first * stride, records.data(), records.size());
-    if (got != records.size()) throw truncated(first + got / stride);
     positions.resize(count);
-    splitRecords(records.data(), count, positions.data(), nullptr);
+    // A megabyte of records at a time, into each thread's buffer (kept: no fresh pages a range).
+    const std::size_t stride = mHeader.vertexBytes;
+    const std::size_t slice = std::max<std::size_t>(1, (std::size_t(1) << 20) / stride);
+    thread_local std::vector<std::byte> records;
+    for (std::size_t done = 0; done < count; done += slice) {
+      const std::size_t n = std::min(slice, count - done);
+      records.resize(n * stride);
+      const std::size_t got =
+          mFile.readAt(mHeader.dataOffset + (first + done) * stride, records.data(), records.size());
+      if (got != records.size()) throw truncated(first + done + got / stride);
+      splitRecords(records.data(), n, positions.data() + done, nullptr);
+    }
     return true;
   }
 

@@ -68,6 +68,16 @@ inline void readChunks(ParticleSource& source) {
     }
     source.rewind();
   }
+  // Random access, where the source offers it, at both ends of the count it claims.
+  if (const auto count = source.countHint(); count && *count > 0) {
+    std::vector<glm::vec3> positions;
+    const std::vector<std::uint64_t> some{0, *count / 2, *count - 1};
+    if (source.readPositionsAt(some, positions) && positions.size() != some.size())
+      throw LogicError("readPositionsAt gave another count");
+    const std::uint64_t n = std::min<std::uint64_t>(*count, 1000);
+    if (source.readPositionRange(*count - n, n, positions) && positions.size() != n)
+      throw LogicError("readPositionRange gave another count");
+  }
 }
 
 /// Reads a file completely (at most kMaxParticles), then again with every attribute it lists
