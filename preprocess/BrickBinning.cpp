@@ -179,28 +179,21 @@ std::uint16_t quantizeAttribute(float s, float min, float max) {
   return std::uint16_t(std::uint16_t(whole) + (x - whole >= 0.5f ? 1 : 0));
 }
 
+namespace {
+
+/// Turns the batch keys of `batch`, whose values lie beside them (KeyGrid::valuesBesideKeys), into
+/// binning keys in place, the values quantized over [min, max], and frees the values: the split
+/// by brick moves the keys alone.
 void makeBinningKeys(KeyBatch& batch, const KeyGrid& grid, float min, float max) {
-  const bool attribute = grid.attribute(), kinds = grid.header.particleKinds;
+  const bool kinds = grid.header.particleKinds;
   std::uint64_t* keys = batch.cellKeys.data();
   const float* values = batch.values.data();
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, batch.cellKeys.size(), 1 << 16), [&](const auto& range) {
-    for (std::size_t i = range.begin(); i != range.end(); ++i) {
-      std::uint64_t cellKey = keys[i];
-      float value = 0.0f;
-      if (grid.valueInKey) {
-        const auto high = std::uint32_t(keys[i] >> 32);
-        cellKey = (high & ((1u << kPackedCellBits) - 1)) | (std::uint64_t(high >> kPackedCellBits) << kKindShift);
-        value = std::bit_cast<float>(std::uint32_t(keys[i]));
-      } else if (attribute) {
-        value = values[i];
-      }
-      keys[i] = binningKey(cellKey, attribute ? quantizeAttribute(value, min, max) : 0, kinds);
-    }
+    for (std::size_t i = range.begin(); i != range.end(); ++i)
+      keys[i] = binningKey(keys[i], quantizeAttribute(values[i], min, max), kinds);
   });
   ValueVector().swap(batch.values);
 }
-
-namespace {
 
 constexpr std::uint32_t kDigitBits = 16;
 constexpr std::size_t kParallelThreshold = 1 << 16;
@@ -284,6 +277,62 @@ struct BrickParts {
   }
 };
 
+/// Where the fields of a key lie as binKeys reads it: the brick code, the cell in the brick,
+/// the kind and the 16-bit attribute. Binning keys (binningKey); or batch keys read as they are,
+/// their attribute quantized as it is read, so that no pass over the keys turns them into
+/// binning keys first (KeyBatch's layouts: Packed, [kind][cell key: 30][value]; Plain, a store
+/// without an attribute, [kind at 48][cell key]). Each field is the binning key's.
+struct KeyFields {
+  enum class Layout { Binning, Packed, Plain };
+  Layout layout = Layout::Binning;
+  bool kinds = false;
+  float min = 0, max = 0;  ///< the attribute's quantization range (Packed)
+  std::uint32_t cellBits = 0;
+
+  /// The cell key's lowest bit.
+  std::uint32_t cellShift() const { return layout == Layout::Binning ? 16 : layout == Layout::Packed ? 32 : 0; }
+  /// The brick code's lowest bit.
+  std::uint32_t codeShift() const { return cellShift() + cellBits; }
+  std::uint32_t cellOf(std::uint64_t key) const {
+    return std::uint32_t((key >> cellShift()) & ((std::uint64_t(1) << cellBits) - 1));
+  }
+  ParticleKind kindOf(std::uint64_t key) const {
+    switch (layout) {
+      case Layout::Binning:
+        return ParticleKind(key & 3);
+      case Layout::Packed:
+        return ParticleKind(key >> (32 + kPackedCellBits));
+      case Layout::Plain:
+        break;
+    }
+    return ParticleKind((key >> kKindShift) & 3);
+  }
+  /// The binning key's attribute field, widened back to 16 bits with kinds (14 stored).
+  std::uint16_t attributeOf(std::uint64_t key) const {
+    if (layout == Layout::Plain) return 0;
+    const std::uint64_t binning = layout == Layout::Binning ? key : binningKeyOf(key);
+    if (!kinds) return std::uint16_t(binning & 0xffff);
+    const auto narrow = std::uint32_t((binning >> 2) & 0x3fff);
+    return std::uint16_t((narrow << 2) | (narrow >> 12));  // 14 bits widened: 0 -> 0, 16383 -> 65535
+  }
+  /// What makeBinningKeys would make of `key`.
+  std::uint64_t binningKeyOf(std::uint64_t key) const {
+    switch (layout) {
+      case Layout::Binning:
+        return key;
+      case Layout::Packed: {
+        const auto high = std::uint32_t(key >> 32);
+        const std::uint64_t cellKey =
+            (high & ((1u << kPackedCellBits) - 1)) | (std::uint64_t(high >> kPackedCellBits) << kKindShift);
+        return binningKey(cellKey, quantizeAttribute(std::bit_cast<float>(std::uint32_t(key)), min, max), kinds);
+      }
+      case Layout::Plain:
+        break;
+    }
+    return binningKey(key, 0, kinds);
+  }
+};
+
 /// What decodeRun reuses from one brick to the next (one a thread).
 struct DecodeScratch {
   std::vector<std::uint32_t> histogram;  ///< per cell of a dense brick: its keys, then its first attribute slot
@@ -295,8 +344,9 @@ struct DecodeScratch {
 /// Encodes one brick's keys (same brick code, any order, in the runs of `parts` of `all`) into
 /// `out` (reuses its vectors); with `kinds`, a cell's kind is the smallest of its keys' (the key
 /// layout of binningKey).
-void decodeRun(std::uint64_t* all, const BrickParts& parts, const KeyGrid& grid, bool attribute, bool kinds,
-               DecodedBrick& out, DecodeScratch& scratch) {
+void decodeRun(std::uint64_t* all, const BrickParts& parts, const KeyGrid& grid, const KeyFields& fields,
+               bool attribute, DecodedBrick& out, DecodeScratch& scratch) {
+  const bool kinds = fields.kinds;
   std::vector<std::uint32_t>& histogram = scratch.histogram;
   std::vector<ParticleKind>& cellKinds = scratch.cellKinds;
   std::vector<std::uint64_t>& gathered = scratch.gathered;
@@ -305,28 +355,28 @@ void decodeRun(std::uint64_t* all, const BrickParts& parts, const KeyGrid& grid,
   out.attributes.clear();
   out.kinds.clear();
   const std::uint32_t cellsPerBrick = grid.header.cellsPerBrick();
-  const std::uint64_t cellMask = (1ull << grid.cellBits) - 1;
-  auto cellOf = [&](std::uint64_t key) { return std::uint32_t((key >> 16) & cellMask); };
-  auto kindOf = [](std::uint64_t key) { return ParticleKind(key & 3); };
-  auto attributeOf = [kinds](std::uint64_t key) {
-    if (!kinds) return std::uint16_t(key & 0xffff);
-    const auto narrow = std::uint32_t((key >> 2) & 0x3fff);
-    return std::uint16_t((narrow << 2) | (narrow >> 12));  // 14 bits widened: 0 -> 0, 16383 -> 65535
-  };
+  const auto cellOf = [&](std::uint64_t key) { return fields.cellOf(key); };
+  const auto kindOf = [&](std::uint64_t key) { return fields.kindOf(key); };
+  const auto attributeOf = [&](std::uint64_t key) { return fields.attributeOf(key); };
   const std::size_t total = parts.keys();
   auto forEachKey = [&](auto f) {
     for (std::size_t r = 0; r < parts.count; ++r)
       for (std::size_t i = parts.runs[r].begin; i != parts.runs[r].end; ++i) f(all[i]);
   };
   if (total * 16 < cellsPerBrick) {
-    // Sparse: sort (cell, attribute) directly.
+    // Sparse: sort the binning keys, (cell, attribute), directly.
     std::span<std::uint64_t> keys(all + parts.runs[0].begin, parts.runs[0].end - parts.runs[0].begin);
-    if (parts.count > 1) {
+    if (parts.count > 1 || fields.layout != KeyFields::Layout::Binning) {
       gathered.clear();
-      forEachKey([&](std::uint64_t k) { gathered.push_back(k); });
+      forEachKey([&](std::uint64_t k) { gathered.push_back(fields.binningKeyOf(k)); });
       keys = gathered;
     }
     std::sort(keys.begin(), keys.end());
+    KeyFields sorted = fields;
+    sorted.layout = KeyFields::Layout::Binning;
+    const auto cellOf = [&](std::uint64_t key) { return sorted.cellOf(key); };
+    const auto kindOf = [&](std::uint64_t key) { return sorted.kindOf(key); };
+    const auto attributeOf = [&](std::uint64_t key) { return sorted.attributeOf(key); };
     for (std::size_t i = 0; i < keys.size(); ++i) {
       const std::uint32_t cell = cellOf(keys[i]);
       if (out.cells.empty() || out.cells.back() != cell) {
@@ -384,11 +434,22 @@ void decodeRun(std::uint64_t* all, const BrickParts& parts, const KeyGrid& grid,
 
 }  // namespace
 
-void binKeys(std::span<std::uint64_t> keys, const KeyGrid& grid, int zstdLevel,
+void binKeys(KeyBatch& keyBatch, const KeyGrid& grid, float min, float max, int zstdLevel,
              const std::function<void(EncodedBrick&&)>& sink) {
+  KeyFields fields;
+  fields.kinds = grid.header.particleKinds;
+  fields.min = min;
+  fields.max = max;
+  fields.cellBits = grid.cellBits;
+  if (grid.valuesBesideKeys())  // the values must travel with the keys through the split
+    makeBinningKeys(keyBatch, grid, min, max);
+  else
+    fields.layout = grid.attribute() ? KeyFields::Layout::Packed : KeyFields::Layout::Plain;
+  std::span<std::uint64_t> keys(keyBatch.cellKeys);
   if (keys.empty()) return;
-  const bool attribute = grid.attribute(), kinds = grid.header.particleKinds;
-  const std::uint32_t lowBit = 16 + grid.cellBits;
+  const bool attribute = grid.attribute();
+  const std::uint32_t lowBit = fields.codeShift();
+  const std::uint64_t codeMask = (std::uint64_t(1) << grid.codeBits) - 1;
   // The in-place split moves keys one at a time: stripes of the keys are split on their own,
   // in parallel, and a brick's keys are its runs of every stripe (decodeRun does not need them
   // in one piece, nor in order).
@@ -404,7 +465,7 @@ void binKeys(std::span<std::uint64_t> keys, const KeyGrid& grid, int zstdLevel,
   {
     std::vector<std::pair<std::uint64_t, BrickRun>> all;
     for (const auto& runs : stripeRuns)
-      for (const BrickRun& run : runs) all.emplace_back(keys[run.begin] >> lowBit, run);
+      for (const BrickRun& run : runs) all.emplace_back((keys[run.begin] >> lowBit) & codeMask, run);
     std::stable_sort(all.begin(), all.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     for (const auto& [code, run] : all) {
       if (bricks.empty() || bricks.back().code != code) bricks.push_back({code, 0, {}});
@@ -422,7 +483,7 @@ void binKeys(std::span<std::uint64_t> keys, const KeyGrid& grid, int zstdLevel,
       const BrickParts& parts = bricks[first + i];
       thread_local DecodedBrick brick;
       thread_local DecodeScratch scratch;
-      decodeRun(keys.data(), parts, grid, attribute, kinds, brick, scratch);
+      decodeRun(keys.data(), parts, grid, fields, attribute, brick, scratch);
       EncodedBrick& e = batch[i];
       for (ParticleKind kind : brick.kinds) ++e.kindCells[std::size_t(kind)];
       e.coord = glm::uvec3(mortonDecode3(std::uint32_t(parts.code)));

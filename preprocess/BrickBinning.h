@@ -72,7 +72,7 @@ using ValueVector = UninitializedVector<float>;
 /// - [ kind : 2 at bit 48 ][ cell key : 48 ], and values[i] the attribute value when the store
 ///   has one (grids whose cell keys need more than 30 bits).
 /// The attribute's quantization range is known only after the whole frame was read, so the
-/// value travels with the key until makeBinningKeys().
+/// value travels with the key until binKeys() reads it.
 struct KeyBatch {
   KeyVector cellKeys;
   ValueVector values;
@@ -118,10 +118,6 @@ inline std::uint64_t binningKey(std::uint64_t cellKey, std::uint16_t attribute, 
   return ((cellKey & kCellKeyMask) << 16) | (narrow << 2) | (cellKey >> kKindShift);
 }
 
-/// Turns the batch keys of `batch` into binning keys in place (binningKey, with the attribute
-/// quantized over [min, max]) and frees its values.
-void makeBinningKeys(KeyBatch& batch, const KeyGrid& grid, float min, float max);
-
 /// One encoded brick, ready for FrameWriter::addBrick.
 struct EncodedBrick {
   glm::uvec3 coord;
@@ -131,10 +127,14 @@ struct EncodedBrick {
   std::vector<std::byte> payload;
 };
 
-/// Sorts `keys` (binning keys) by brick in place (in stripes, see BrickBinning.cpp), groups them
+/// Sorts the keys of `batch` by brick in place (in stripes, see BrickBinning.cpp), groups them
 /// and encodes each brick, with a kind per cell when the store has kinds; calls `sink` in
-/// ascending Morton order. Memory: keys + one batch of compressed payloads.
-void binKeys(std::span<std::uint64_t> keys, const KeyGrid& grid, int zstdLevel,
+/// ascending Morton order. The attribute is quantized over [min, max] (quantizeAttribute) as
+/// each key is read: the bricks are those of the binning keys (binningKey), without a pass over
+/// every key that makes them first, except where the values lie beside the keys. Frees the
+/// batch's values; its keys are left in another order. Memory: keys + one batch of compressed
+/// payloads.
+void binKeys(KeyBatch& batch, const KeyGrid& grid, float min, float max, int zstdLevel,
              const std::function<void(EncodedBrick&&)>& sink);
 
 }  // namespace flipscope::detail

@@ -370,15 +370,15 @@ class FrameBinner {
     }
   }
 
-  /// Bins `batch` into `writer`; its keys become binning keys (the batch is empty after).
+  /// Bins `batch` into `writer` (the batch is empty after).
   void binInMemory(KeyBatch& batch, FrameWriter& writer) {
-    detail::makeBinningKeys(batch, mGrid, mStats.attributeMin, mStats.attributeMax);
-    detail::binKeys(batch.cellKeys, mGrid, mOptions.zstdLevel, [&](detail::EncodedBrick&& brick) {
-      writer.addBrick(brick.coord, brick.particles, brick.cells, brick.payload);
-      mStats.particles += brick.particles;
-      for (std::size_t k = 0; k < kParticleKindCount; ++k) mStats.kindCells[k] += brick.kindCells[k];
-      stopPoint("brick");
-    });
+    detail::binKeys(batch, mGrid, mStats.attributeMin, mStats.attributeMax, mOptions.zstdLevel,
+                    [&](detail::EncodedBrick&& brick) {
+                      writer.addBrick(brick.coord, brick.particles, brick.cells, brick.payload);
+                      mStats.particles += brick.particles;
+                      for (std::size_t k = 0; k < kParticleKindCount; ++k) mStats.kindCells[k] += brick.kindCells[k];
+                      stopPoint("brick");
+                    });
     batch.clear();
   }
 
