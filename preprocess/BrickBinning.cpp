@@ -337,13 +337,13 @@ struct KeyFields {
 struct DecodeScratch {
   std::vector<std::uint32_t> histogram;  ///< per cell of a dense brick: its keys, then its first attribute slot
   std::vector<ParticleKind> cellKinds;   ///< per cell of a dense brick
-  std::vector<std::uint64_t> gathered;   ///< the keys of a sparse brick of several runs
+  std::vector<std::uint64_t> gathered;   ///< a sparse brick's binning keys, in one piece to sort
   UninitializedVector<std::uint32_t> cells, counts;  ///< a dense brick's occupied cells, written without a branch
 };
 
-/// Encodes one brick's keys (same brick code, any order, in the runs of `parts` of `all`) into
-/// `out` (reuses its vectors); with `kinds`, a cell's kind is the smallest of its keys' (the key
-/// layout of binningKey).
+/// Encodes one brick's keys (same brick code, any order, in the runs of `parts` of `all`, their
+/// fields where `fields` says) into `out` (reuses its vectors); with kinds, a cell's kind is the
+/// smallest of its keys'.
 void decodeRun(std::uint64_t* all, const BrickParts& parts, const KeyGrid& grid, const KeyFields& fields,
                bool attribute, DecodedBrick& out, DecodeScratch& scratch) {
   const bool kinds = fields.kinds;

@@ -491,7 +491,8 @@ bool addInParallel(ParticleSource& source, KthNeighbours& search, FiniteTally& t
     for (std::uint64_t i = r.begin(); i != r.end(); ++i) {
       const std::uint64_t first = i * kChunkParticles;
       const std::size_t n = std::size_t(std::min<std::uint64_t>(kChunkParticles, *count - first));
-      FLIPSCOPE_CHECK(source.readPositionRange(first, n, reader.positions), "a source stopped reading ranges");
+      if (!source.readPositionRange(first, n, reader.positions))
+        throw LogicError(source.name() + ": the source stopped reading ranges of particles");
       search.addConcurrently(reader.positions, first);
       reader.tally.add(reader.positions);
       if (progress) progress->advance(n);
