@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -525,6 +526,12 @@ std::string formatNumber(double v) {
   return text;
 }
 
+/// The shortest decimal that reads back as `v` exactly.
+std::string formatExact(double v) {
+  char text[32];
+  return std::string(text, std::to_chars(text, text + sizeof text, v).ptr);
+}
+
 /// What a pass over the positions alone reads: no velocities, no attributes.
 ReadOptions positionsOnly(ReadOptions read) {
   read.velocity = false;
@@ -1034,6 +1041,10 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
                                                            : std::string(upAxisName(header.upAxis)) + " up") +
                          " (store version " + std::to_string(header.version) + "), not " +
                          std::string(upAxisName(*options.upAxis)) + " (--up); convert into a new store to change it");
+      if (options.cellSize && *options.cellSize != header.cellSize)
+        throw InputError(storeDir.string() + ": the store's cells are " + formatExact(header.cellSize) +
+                         " world units, not " + formatExact(*options.cellSize) +
+                         " (--cell-size); convert into a new store to change them");
       report.cellSizeOrigin = "kept from the existing store";
       report.spacingOrigin = "the existing store";
       report.upAxisOrigin = header.version >= 6 ? "the existing store" : "a store older than version 6 records none";

@@ -356,6 +356,31 @@ TEST(ConvertSpacing, GivenCellSizeOrResolutionStillRecordsTheSpacing) {
   EXPECT_EQ(convert({{0, {raw}}}, temp / "d", options).header.cellSize, 0.25);
 }
 
+TEST(ConvertSpacing, AStoreConvertedIntoAgainKeepsItsCellsAndRefusesOthersByNumber) {
+  testing::TempDir temp("cell-size-kept");
+  const fs::path raw = temp / "lattice.bin";
+  writeRaw(raw, latticePoints(10, 0.2f, {1, 2, 3}));
+  ConvertOptions options = silent();
+  options.cellSize = 0.3;
+  convert({{0, {raw}}}, temp / "s", options);
+  // The same cell size, or none given: kept, the frame added.
+  const ConvertReport same = convert({{1, {raw}}}, temp / "s", options);
+  EXPECT_EQ(same.header.cellSize, 0.3);
+  EXPECT_EQ(same.cellSizeOrigin, "kept from the existing store");
+  EXPECT_EQ(convert({{2, {raw}}}, temp / "s", silent()).header.cellSize, 0.3);
+  // Another, even in the last digit: refused, the store as it was.
+  options.cellSize = std::nextafter(0.3, 1.0);
+  try {
+    convert({{3, {raw}}}, temp / "s", options);
+    FAIL() << "converted into the store with other cells";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cells are 0.3 world units, not 0.30000000000000004 (--cell-size)"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(BrickStore::open(temp / "s").frames(), (std::vector<int>{0, 1, 2}));
+}
+
 TEST(ConvertSpacing, SpacingThatOverflowsTheGridFallsBackToTheDefaultResolution) {
   testing::TempDir temp("spacing-fallback");
   auto points = latticePoints(16, 1e-4f);
