@@ -2,10 +2,8 @@
 // uninitialized, for large buffers that are overwritten right away (sort keys, scratch):
 // no memset, and pages are touched only once, by the writer.
 //
-// No transparent huge pages: on the virtual machine we measured (the development machine,
-// 2026-12-03, `madvise` THP), the first touch of 400 MB advised MADV_HUGEPAGE took 0.3 to 3.1 s
-// and of 400 MB of plain pages 0.13 s, every time (most likely because a 2 MiB page comes from
-// the blocks the guest has handed back to its host, which must back all of it again).
+// Huge pages are not this allocator's business: whether large allocations ask for them is
+// chosen per machine for the whole process (core/HugePageAdvice.h).
 #pragma once
 
 #include <memory>

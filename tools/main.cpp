@@ -2,9 +2,11 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <cstring>
 #include <exception>
 
 #include "core/Error.h"
+#include "core/HugePageAdvice.h"
 #include "core/ProcessMemory.h"
 #include "tools/Commands.h"
 
@@ -24,6 +26,11 @@ int main(int argc, char** argv) {
   tools::addViewCommand(app);
   tools::addFarmCommand(app);
   try {
+    // Huge pages where they fill faster, for the commands that allocate large buffers: not for
+    // those that read headers (info, inspect), nor --help and --version.
+    const bool headersOnly =
+        argc < 2 || argv[1][0] == '-' || std::strcmp(argv[1], "info") == 0 || std::strcmp(argv[1], "inspect") == 0;
+    if (!headersOnly) chooseHugePageAdvice();
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     int code = app.exit(e);

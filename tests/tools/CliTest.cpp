@@ -15,6 +15,18 @@ namespace fs = std::filesystem;
 using flipscope::testing::CommandRun;
 CommandRun run(const std::string& args) { return flipscope::testing::runFlipscope(args); }
 
+/// A frame file's bytes but for the store id (random per store) and the index checksum over it:
+/// the footer's bytes 40 to 24 and 16 to 8 from the end of the file, zeroed. `id`: what was there.
+std::string frameBytesWithoutStoreId(const fs::path& frameFile, std::string* id = nullptr) {
+  std::ifstream in(frameFile, std::ios::binary);
+  std::string bytes(std::istreambuf_iterator<char>(in), {});
+  if (bytes.size() < 40) return bytes;
+  if (id) *id = bytes.substr(bytes.size() - 40, 16);
+  bytes.replace(bytes.size() - 40, 16, 16, '\0');
+  bytes.replace(bytes.size() - 16, 8, 8, '\0');
+  return bytes;
+}
+
 class Cli : public ::testing::Test {
  protected:
   std::string path(const std::string& name) const { return (dir / name).string(); }
@@ -174,21 +186,33 @@ TEST_F(Cli, OutOfCoreConvertMatchesInCore) {
   CommandRun out = run("convert " + path("big.bin") + " -o " + path("b") + " --resolution 256 --mem 2M");
   ASSERT_EQ(out.exitCode, 0) << out.output;
   EXPECT_NE(out.output.find("out of core"), std::string::npos) << out.output;
-  auto bytes = [](const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-  };
-  // The same bytes but for the store id (random per store) and the index checksum over it, the
-  // footer's bytes 40 to 24 and 16 to 8 from the end of the file.
-  std::string a = bytes(dir / "a" / "frame_000000.fsf"), b = bytes(dir / "b" / "frame_000000.fsf");
-  ASSERT_EQ(a.size(), b.size());
+  std::string idA, idB;
+  const std::string a = frameBytesWithoutStoreId(dir / "a" / "frame_000000.fsf", &idA);
+  const std::string b = frameBytesWithoutStoreId(dir / "b" / "frame_000000.fsf", &idB);
   ASSERT_GT(a.size(), 40u);
-  EXPECT_NE(a.substr(a.size() - 40, 16), b.substr(b.size() - 40, 16)) << "two stores with the same id";
-  for (std::string* s : {&a, &b}) {
-    s->replace(s->size() - 40, 16, 16, '\0');
-    s->replace(s->size() - 16, 8, 8, '\0');
-  }
+  EXPECT_NE(idA, idB) << "two stores with the same id";
   EXPECT_EQ(a, b);
+}
+
+// Huge page advice (core/HugePageAdvice.h) changes where memory comes from, never a byte of a
+// store; a value of FLIPSCOPE_HUGE_PAGES that is none of on, off, auto is a usage error.
+TEST_F(Cli, HugePageAdviceOnOrOffWritesTheSameStore) {
+  ASSERT_EQ(run("synth -o " + path("f.bin") + " --particles 600k").exitCode, 0);
+  ::setenv("FLIPSCOPE_HUGE_PAGES", "on", 1);
+  const CommandRun on = run("convert " + path("f.bin") + " -o " + path("on") + " --resolution 256 -q");
+  ::setenv("FLIPSCOPE_HUGE_PAGES", "off", 1);
+  const CommandRun off = run("convert " + path("f.bin") + " -o " + path("off") + " --resolution 256 -q");
+  ::setenv("FLIPSCOPE_HUGE_PAGES", "maybe", 1);
+  const CommandRun bad = run("convert " + path("f.bin") + " -o " + path("bad") + " --resolution 256 -q");
+  ::unsetenv("FLIPSCOPE_HUGE_PAGES");
+  ASSERT_EQ(on.exitCode, 0) << on.output;
+  ASSERT_EQ(off.exitCode, 0) << off.output;
+  EXPECT_EQ(bad.exitCode, 2) << bad.output;
+  EXPECT_NE(bad.output.find("FLIPSCOPE_HUGE_PAGES: on, off or auto, not 'maybe'"), std::string::npos) << bad.output;
+  EXPECT_FALSE(fs::exists(dir / "bad"));
+  const std::string a = frameBytesWithoutStoreId(dir / "on" / "frame_000000.fsf");
+  ASSERT_GT(a.size(), 40u);
+  EXPECT_EQ(a, frameBytesWithoutStoreId(dir / "off" / "frame_000000.fsf"));
 }
 
 // Issue 12, list item 8: every kind of failure has its exit code and a message naming the file.

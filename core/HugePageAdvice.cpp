@@ -1,0 +1,84 @@
+#include "core/HugePageAdvice.h"
+
+#include <sys/mman.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <cstdlib>
+#include <fstream>
+
+#include "core/Error.h"
+
+namespace flipscope {
+namespace {
+
+std::atomic<bool> gAdvice{false};
+
+constexpr std::uintptr_t kHugePage = std::uintptr_t(2) << 20;
+
+/// Seconds to write one byte a page of a fresh mapping of `bytes` (2 MiB-aligned), advised or not.
+double touchFresh(std::size_t bytes, bool advised) {
+  const std::size_t mapped = bytes + kHugePage;
+  void* map = ::mmap(nullptr, mapped, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  if (map == MAP_FAILED) return 0;
+  auto* begin =
+      reinterpret_cast<volatile char*>((reinterpret_cast<std::uintptr_t>(map) + kHugePage - 1) & ~(kHugePage - 1));
+  if (advised) ::madvise(const_cast<char*>(begin), bytes, MADV_HUGEPAGE);
+  const std::size_t page = std::size_t(::sysconf(_SC_PAGESIZE));
+  const auto start = std::chrono::steady_clock::now();
+  for (std::size_t i = 0; i < bytes; i += page) begin[i] = 1;
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ::munmap(map, mapped);
+  return seconds;
+}
+
+}  // namespace
+
+bool hugePageAdviceOn() { return gAdvice.load(std::memory_order_relaxed); }
+
+void setHugePageAdvice(bool on) { gAdvice.store(on, std::memory_order_relaxed); }
+
+void adviseHugePages(void* p, std::size_t bytes) {
+  const std::uintptr_t page = std::uintptr_t(::sysconf(_SC_PAGESIZE));
+  const std::uintptr_t begin = reinterpret_cast<std::uintptr_t>(p) & ~(page - 1);
+  const std::uintptr_t end = (reinterpret_cast<std::uintptr_t>(p) + bytes + page - 1) & ~(page - 1);
+  ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+}
+
+bool transparentHugePagesAvailable() {
+  std::ifstream in("/sys/kernel/mm/transparent_hugepage/enabled");
+  std::string modes;
+  return std::getline(in, modes) && modes.find("[never]") == std::string::npos;
+}
+
+FirstTouchSeconds measureFirstTouch(std::size_t bytes) {
+  FirstTouchSeconds s;
+  s.plainPages = touchFresh(bytes, false);
+  s.hugePages = touchFresh(bytes, true);
+  return s;
+}
+
+bool hugePagesWorthAdvising(const FirstTouchSeconds& measured) {
+  return measured.plainPages > 0 && measured.hugePages > 0 && 2 * measured.hugePages <= measured.plainPages;
+}
+
+std::optional<bool> hugePagePolicyFromEnvironment(const char* value) {
+  if (!value) return std::nullopt;
+  const std::string v = value;
+  if (v == "on") return true;
+  if (v == "off") return false;
+  if (v == "auto" || v.empty()) return std::nullopt;
+  throw InputError("FLIPSCOPE_HUGE_PAGES: on, off or auto, not '" + v + "'");
+}
+
+bool chooseHugePageAdvice() {
+  const std::optional<bool> asked = hugePagePolicyFromEnvironment(std::getenv("FLIPSCOPE_HUGE_PAGES"));
+  const bool on = asked ? *asked
+                        : transparentHugePagesAvailable() && hugePagesWorthAdvising(measureFirstTouch(kHugePage * 2));
+  setHugePageAdvice(on);
+  return on;
+}
+
+}  // namespace flipscope

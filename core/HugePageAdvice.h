@@ -1,0 +1,55 @@
+// Whether large allocations ask for transparent huge pages (madvise MADV_HUGEPAGE), chosen
+// per machine, since what a page fault costs differs from one virtual machine to the next.
+//
+// Measured on the development machine's two kinds of 2-core VM (a C program writing one byte
+// a page of a fresh 400 MB mapping): on one, 0.13 s in 4 KiB pages and 0.3 to 3.1 s advised;
+// on the other, 1.03 s in 4 KiB pages and 0.03 to 0.7 s advised, where advising made a 20 M
+// particle convert plus first image twice as fast. Neither choice suits both, so a command
+// that allocates large buffers measures both kinds of first touch once, on a few megabytes,
+// and advises only where huge pages were the faster (chooseHugePageAdvice).
+//
+// FLIPSCOPE_HUGE_PAGES=on|off|auto (default auto: measure) overrides the measurement.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+
+namespace flipscope {
+
+/// Allocations of at least this many bytes are advised while advice is on (smaller ones
+/// cannot hold a whole 2 MiB page).
+inline constexpr std::size_t kHugePageAdvisedBytes = std::size_t(2) << 20;
+
+/// Whether operator new advises the allocations of kHugePageAdvisedBytes and more (the
+/// flipscope executable's operator new reads it; see tools/LargeAllocations.cpp). Off until set.
+bool hugePageAdviceOn();
+void setHugePageAdvice(bool on);
+
+/// Advises the pages of [p, p + bytes) MADV_HUGEPAGE. The kernel backs with huge pages only the
+/// 2 MiB-aligned stretches inside one mapping; the rest is unchanged. Failure is ignored: advice.
+void adviseHugePages(void* p, std::size_t bytes);
+
+/// What the kernel does with MADV_HUGEPAGE here: false where transparent huge pages are off
+/// (/sys/kernel/mm/transparent_hugepage/enabled says [never], or is missing).
+bool transparentHugePagesAvailable();
+
+/// The first touch of `bytes` of fresh memory, in seconds: in 4 KiB pages, and advised.
+struct FirstTouchSeconds {
+  double plainPages = 0;
+  double hugePages = 0;
+};
+FirstTouchSeconds measureFirstTouch(std::size_t bytes);
+
+/// Advice on when huge pages touch at most half as long as 4 KiB pages.
+bool hugePagesWorthAdvising(const FirstTouchSeconds& measured);
+
+/// FLIPSCOPE_HUGE_PAGES's value: true (on), false (off), nullopt (auto or unset). Throws
+/// InputError, naming the variable, for another value.
+std::optional<bool> hugePagePolicyFromEnvironment(const char* value);
+
+/// Sets the advice for this process: as FLIPSCOPE_HUGE_PAGES says, else measured
+/// (measureFirstTouch of 4 MiB, about 10 to 40 ms). Returns what it chose.
+bool chooseHugePageAdvice();
+
+}  // namespace flipscope
