@@ -24,6 +24,15 @@ using flipscope::testing::runFlipscope;
 
 constexpr int kFrames = 8;
 
+/// Rounds of a race: `usual`, or FLIPSCOPE_RACE_ROUNDS where set. tests/run-asan.sh sets 1: the
+/// plain run repeats the races, and under the sanitizers one round checks each path's memory
+/// (each round is a dozen processes, ten times slower there).
+int raceRounds(int usual) {
+  const char* text = std::getenv("FLIPSCOPE_RACE_ROUNDS");
+  const int asked = text ? std::atoi(text) : 0;
+  return asked > 0 ? asked : usual;
+}
+
 class ConcurrentConvert : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -61,7 +70,7 @@ class ConcurrentConvert : public ::testing::Test {
 };
 
 TEST_F(ConcurrentConvert, InterleavedFramesIntoAPreparedStoreAreAllThereAndIntact) {
-  for (int round = 0; round < 6; ++round) {
+  for (int round = 0; round < raceRounds(6); ++round) {
     SCOPED_TRACE("round " + std::to_string(round));
     const std::string store = path("s" + std::to_string(round));
     CommandRun prepare = runFlipscope("convert " + path("in_####.bin") + " -o " + store + " --prepare -q");
@@ -95,7 +104,7 @@ TEST_F(ConcurrentConvert, WritersThatCreateTheStoreTogetherAgreeOnOneHeader) {
   char domain[256];
   std::snprintf(domain, sizeof domain, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", h.origin.x, h.origin.y, h.origin.z,
                 max.x, max.y, max.z);
-  for (int round = 0; round < 6; ++round) {
+  for (int round = 0; round < raceRounds(6); ++round) {
     SCOPED_TRACE("round " + std::to_string(round));
     const std::string store = path("c" + std::to_string(round));
     std::vector<std::string> commands;
@@ -111,7 +120,7 @@ TEST_F(ConcurrentConvert, WritersThatCreateTheStoreTogetherAgreeOnOneHeader) {
 }
 
 TEST_F(ConcurrentConvert, TwoWritersOfTheSameFrameLeaveOneCompleteFile) {
-  for (int round = 0; round < 4; ++round) {
+  for (int round = 0; round < raceRounds(4); ++round) {
     const std::string store = path("same" + std::to_string(round));
     ASSERT_EQ(runFlipscope("convert " + path("in_####.bin") + " -o " + store + " --prepare -q").exitCode, 0);
     const std::string frame3 = "convert " + path("in_####.bin") + " --frames 3 -o " + store + " --append -q";
