@@ -16,10 +16,9 @@ namespace {
 
 std::atomic<bool> gAdvice{false};
 
-constexpr std::uintptr_t kHugePage = std::uintptr_t(2) << 20;
-
 /// Seconds to write one byte a page of a fresh mapping of `bytes` (2 MiB-aligned), advised or not.
 double touchFresh(std::size_t bytes, bool advised) {
+  constexpr std::uintptr_t kHugePage = kHugePageBytes;
   const std::size_t mapped = bytes + kHugePage;
   void* map = ::mmap(nullptr, mapped, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
   if (map == MAP_FAILED) return 0;
@@ -75,8 +74,8 @@ std::optional<bool> hugePagePolicyFromEnvironment(const char* value) {
 
 bool chooseHugePageAdvice() {
   const std::optional<bool> asked = hugePagePolicyFromEnvironment(std::getenv("FLIPSCOPE_HUGE_PAGES"));
-  const bool on = asked ? *asked
-                        : transparentHugePagesAvailable() && hugePagesWorthAdvising(measureFirstTouch(kHugePage * 2));
+  const bool on =
+      asked ? *asked : transparentHugePagesAvailable() && hugePagesWorthAdvising(measureFirstTouch(kHugePageBytes * 2));
   setHugePageAdvice(on);
   return on;
 }

@@ -17,11 +17,11 @@
 
 namespace flipscope {
 
-/// Allocations of at least this many bytes are advised while advice is on (smaller ones
-/// cannot hold a whole 2 MiB page).
-inline constexpr std::size_t kHugePageAdvisedBytes = std::size_t(2) << 20;
+/// A transparent huge page (x86-64). Allocations of at least this many bytes are advised while
+/// advice is on: smaller ones cannot hold a whole one.
+inline constexpr std::size_t kHugePageBytes = std::size_t(2) << 20;
 
-/// Whether operator new advises the allocations of kHugePageAdvisedBytes and more (the
+/// Whether operator new advises the allocations of kHugePageBytes and more (the
 /// flipscope executable's operator new reads it; see tools/LargeAllocations.cpp). Off until set.
 bool hugePageAdviceOn();
 void setHugePageAdvice(bool on);

@@ -1,5 +1,5 @@
 // The flipscope command's operator new: malloc, and while huge page advice is on
-// (core/HugePageAdvice.h, chosen at start by main()), allocations of kHugePageAdvisedBytes and
+// (core/HugePageAdvice.h, chosen at start by main()), allocations of kHugePageBytes and
 // more advised MADV_HUGEPAGE: the particle columns, key batches, brick scratch and frame
 // images, which fill in one page fault per 2 MiB instead of one per 4 KiB. What glibc's
 // `glibc.malloc.hugetlb=1` tunable does for every malloc, for what we allocate.
@@ -26,7 +26,7 @@
 __attribute__((noinline)) void* operator new(std::size_t bytes) {
   void* p = std::malloc(bytes ? bytes : 1);
   if (!p) throw std::bad_alloc();
-  if (bytes >= flipscope::kHugePageAdvisedBytes && flipscope::hugePageAdviceOn()) flipscope::adviseHugePages(p, bytes);
+  if (bytes >= flipscope::kHugePageBytes && flipscope::hugePageAdviceOn()) flipscope::adviseHugePages(p, bytes);
   return p;
 }
 
