@@ -1,4 +1,5 @@
-// Helpers every test suite shares: scratch directories and running the flipscope binary.
+// Helpers every test suite shares: scratch directories, running the flipscope binary, and the
+// counts the sanitizer runs lower through the environment.
 #pragma once
 
 #include <sys/wait.h>
@@ -6,10 +7,19 @@
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
 namespace flipscope::testing {
+
+/// The positive count the environment variable `name` holds, else `usual` (unset, zero,
+/// negative or not a number). tests/run-asan.sh lowers a few repetitions this way.
+inline long positiveCountFromEnvironment(const char* name, long usual) {
+  const char* text = std::getenv(name);
+  const long asked = text ? std::atol(text) : 0;
+  return asked > 0 ? asked : usual;
+}
 
 /// A fresh directory under the system temporary directory, removed with its content.
 class TempDir {

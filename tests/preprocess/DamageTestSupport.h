@@ -5,11 +5,11 @@
 
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <span>
 #include <string>
 
+#include "TestSupport.h"
 #include "core/Error.h"
 #include "preprocess/particles/ParticleFormatRegistry.h"
 #include "preprocess/particles/ParticleSource.h"
@@ -20,9 +20,7 @@ namespace flipscope::testing {
 /// byte, unless FLIPSCOPE_DAMAGE_STRIDE says otherwise. tests/run-asan.sh sweeps every 4th byte
 /// under the sanitizers, 4x faster; the plain run and the fuzzers cover the rest.
 inline std::size_t damageSweepStride() {
-  const char* text = std::getenv("FLIPSCOPE_DAMAGE_STRIDE");
-  const long stride = text ? std::atol(text) : 1;
-  return stride > 0 ? std::size_t(stride) : 1;
+  return std::size_t(positiveCountFromEnvironment("FLIPSCOPE_DAMAGE_STRIDE", 1));
 }
 
 /// Opens `bytes` as the file `name` and reads every particle, with every attribute, twice

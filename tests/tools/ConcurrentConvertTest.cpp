@@ -28,9 +28,7 @@ constexpr int kFrames = 8;
 /// plain run repeats the races, and under the sanitizers one round checks each path's memory
 /// (each round is a dozen processes, ten times slower there).
 int raceRounds(int usual) {
-  const char* text = std::getenv("FLIPSCOPE_RACE_ROUNDS");
-  const int asked = text ? std::atoi(text) : 0;
-  return asked > 0 ? asked : usual;
+  return int(flipscope::testing::positiveCountFromEnvironment("FLIPSCOPE_RACE_ROUNDS", usual));
 }
 
 class ConcurrentConvert : public ::testing::Test {
