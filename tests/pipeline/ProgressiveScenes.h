@@ -2,9 +2,13 @@
 // so a test controls when conversion finishes, and a loop that advances a frame to the end.
 #pragma once
 
+#include <chrono>
 #include <condition_variable>
 #include <memory>
 #include <mutex>
+#include <thread>
+
+#include <gtest/gtest.h>
 
 #include "pipeline/FramePipeline.h"
 #include "streaming/SyntheticBrickSource.h"
@@ -58,13 +62,18 @@ class GatedBrickSource : public BrickSource {
   bool mOpen = true;
 };
 
-/// Advances the begun frame until it finishes (at most `slices` calls); returns the calls made.
-inline int advanceToEnd(FramePipeline& pipeline, int slices = 100000) {
+/// Advances the begun frame until it finishes; returns the calls made. A slice that changed
+/// nothing (its bricks still converting) is followed by a millisecond's sleep, and the limit is
+/// one of time, not of calls: under the sanitizers, on a loaded machine, conversion is slow and
+/// a bound on calls gave up on a frame that was still streaming. Not finishing is a failure.
+inline int advanceToEnd(FramePipeline& pipeline, std::chrono::seconds limit = std::chrono::seconds(300)) {
+  const auto deadline = std::chrono::steady_clock::now() + limit;
   int calls = 0;
-  while (!pipeline.finished() && calls < slices) {
-    pipeline.advance(5.0);
+  while (!pipeline.finished() && std::chrono::steady_clock::now() < deadline) {
+    if (!pipeline.advance(5.0).changed) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     ++calls;
   }
+  EXPECT_TRUE(pipeline.finished()) << "the frame did not finish in " << limit.count() << " s (" << calls << " slices)";
   return calls;
 }
 
