@@ -2,13 +2,30 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
-#include <cstring>
 #include <exception>
+#include <string>
 
 #include "core/Error.h"
 #include "core/HugePageAdvice.h"
 #include "core/ProcessMemory.h"
 #include "tools/Commands.h"
+
+namespace {
+
+/// Whether the parsed command (its subcommand path, as "farm status") is one that allocates
+/// large buffers: all but info, inspect and the farm's submission, status and finalize.
+bool allocatesLargeBuffers(const CLI::App& app) {
+  std::string path;
+  for (const CLI::App* c = &app; !c->get_subcommands().empty();) {
+    c = c->get_subcommands().front();
+    path += (path.empty() ? "" : " ") + c->get_name();
+  }
+  for (const char* light : {"info", "inspect", "farm convert", "farm render", "farm status", "farm finalize"})
+    if (path == light) return false;
+  return true;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace flipscope;
@@ -25,12 +42,13 @@ int main(int argc, char** argv) {
   tools::addDemoCommand(app);
   tools::addViewCommand(app);
   tools::addFarmCommand(app);
+  // Huge pages where they fill faster (core/HugePageAdvice.h), chosen once the command line has
+  // parsed (not for --help, --version or a usage error) and before the command runs, for the
+  // commands that allocate large buffers: not for those that read headers or submit jobs.
+  app.parse_complete_callback([&app] {
+    if (allocatesLargeBuffers(app)) chooseHugePageAdvice();
+  });
   try {
-    // Huge pages where they fill faster, for the commands that allocate large buffers: not for
-    // those that read headers (info, inspect), nor --help and --version.
-    const bool headersOnly =
-        argc < 2 || argv[1][0] == '-' || std::strcmp(argv[1], "info") == 0 || std::strcmp(argv[1], "inspect") == 0;
-    if (!headersOnly) chooseHugePageAdvice();
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     int code = app.exit(e);
