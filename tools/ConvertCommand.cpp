@@ -128,7 +128,7 @@ void addConvertCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--up", args->up,
                   "The scene's up axis the store records, which render and view frame with: auto (what the input "
-                  "files' conventions say: z for Blender, y for Houdini and RealFlow), x, y or z")
+                  "files' conventions say: z for Blender, y for Houdini, RealFlow and Maya), x, y or z")
       ->capture_default_str();
   cmd->add_option("--zstd-level", args->zstdLevel, "zstd level of brick payloads")
       ->check(CLI::Range(-5, 19))

@@ -1,5 +1,6 @@
 // Attribute names and types shared by every reader (ParticleSource.h, ParticleFormats.h).
 #include <algorithm>
+#include <cctype>
 #include <cstring>
 
 #include "core/Error.h"
@@ -23,6 +24,18 @@ std::string_view valueTypeName(ValueType type) {
     case ValueType::Float64: return "float64";
   }
   return "unknown";
+}
+
+std::optional<std::size_t> detail::velocityAttributeByName(const std::vector<AttributeDesc>& attributes) {
+  auto lower = [](std::string_view text) {
+    std::string out(text);
+    for (char& c : out) c = char(std::tolower(static_cast<unsigned char>(c)));
+    return out;
+  };
+  for (std::string_view name : {"velocity", "velocities", "vel", "v"})
+    for (std::size_t i = 0; i < attributes.size(); ++i)
+      if (attributes[i].arity == 3 && lower(attributes[i].name) == name) return i;
+  return std::nullopt;
 }
 
 std::vector<std::size_t> detail::selectAttributes(const std::vector<AttributeDesc>& available, const ReadOptions& options,

@@ -41,9 +41,6 @@ std::unique_ptr<ParticleWriter> createVtkLegacyWriter(const std::filesystem::pat
 /// (VtuParticles.cpp).
 bool isVtkXml(std::span<const std::byte> head);
 std::unique_ptr<ParticleSource> openVtkXmlParticles(InputFile file, const ReadOptions& options);
-/// The VTK velocity among `attributes`: the 3-component one named velocity, velocities, vel or v
-/// (in that order of preference, case-insensitively).
-std::optional<std::size_t> vtkVelocityAttribute(const std::vector<AttributeDesc>& attributes);
 /// Houdini geometry in its modern JSON forms (houdini/): binary JSON .bgeo (magic 0x7f "NSJb")
 /// and ASCII JSON .geo, as points with their numeric point attributes.
 bool isHoudiniJson(std::span<const std::byte> head);
@@ -76,6 +73,14 @@ std::unique_ptr<ParticleWriter> createPrtWriter(const std::filesystem::path& pat
 bool isRealFlowBin(std::span<const std::byte> head);
 std::unique_ptr<ParticleSource> openRealFlowParticles(InputFile file, const ReadOptions& options);
 
+/// Maya particle disk cache .pdb, little-endian, written by a 32- or 64-bit build (PdbParticles.cpp).
+bool isPdb(std::span<const std::byte> head);
+std::unique_ptr<ParticleSource> openPdbParticles(InputFile file, const ReadOptions& options);
+
+/// The velocity among `attributes` of a format that does not name it (VTK, Maya PDB): the
+/// 3-component one named velocity, velocities, vel or v (in that order of preference,
+/// case-insensitively).
+std::optional<std::size_t> velocityAttributeByName(const std::vector<AttributeDesc>& attributes);
 /// Which of `available` ReadOptions asks for, as indices into `available`, in the order asked
 /// (all of them for allAttributes). Throws FileError naming `file`, the missing attribute and
 /// what the file holds.

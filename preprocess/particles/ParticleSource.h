@@ -116,7 +116,7 @@ class ParticleSource {
   /// concatenation of sources has none.
   virtual std::optional<std::string> kindAttribute() const { return std::nullopt; }
   /// The up axis the file's conventions imply, else Unknown: +z for Blender's fluid caches
-  /// (points grids named `particles`, `particles_secondary`), +y for Houdini and RealFlow.
+  /// (points grids named `particles`, `particles_secondary`), +y for Houdini, RealFlow and Maya.
   /// What convert records in the store unless given `--up`. Of one file, like kindAttribute.
   virtual UpAxis upAxis() const { return UpAxis::Unknown; }
 };

@@ -410,7 +410,7 @@ class VtkLegacyReader final : public ParticleSource {
     mLayout = LayoutParser(mFile).parse();
     for (const auto& array : mLayout.pointData) mAttributes.push_back(array.desc);
     mSelected = selectAttributes(mAttributes, options, mFile.path());
-    if (options.velocity) mVelocity = vtkVelocityAttribute(mAttributes);
+    if (options.velocity) mVelocity = velocityAttributeByName(mAttributes);
     mStreams.push_back(stream(mLayout.positions));
     if (mVelocity) mVelocityStream = addStream(*mVelocity);
     for (std::size_t index : mSelected) mColumnStreams.push_back(addStream(index));
@@ -530,13 +530,6 @@ class VtkLegacyReader final : public ParticleSource {
 };
 
 }  // namespace
-
-std::optional<std::size_t> vtkVelocityAttribute(const std::vector<AttributeDesc>& attributes) {
-  for (std::string_view name : {"velocity", "velocities", "vel", "v"})
-    for (std::size_t i = 0; i < attributes.size(); ++i)
-      if (attributes[i].arity == 3 && lower(attributes[i].name) == name) return i;
-  return std::nullopt;
-}
 
 bool isVtkLegacy(std::span<const std::byte> head) {
   constexpr std::string_view kPrefix = "# vtk DataFile";

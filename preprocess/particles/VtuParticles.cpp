@@ -708,7 +708,7 @@ class VtkXmlReader final : public ParticleSource {
     std::sort(mFormats.begin(), mFormats.end());
     mFormats.erase(std::unique(mFormats.begin(), mFormats.end()), mFormats.end());
     mSelected = selectAttributes(mAttributes, options, mFile.path());
-    if (options.velocity) mVelocity = vtkVelocityAttribute(mAttributes);
+    if (options.velocity) mVelocity = velocityAttributeByName(mAttributes);
   }
 
   std::string name() const override { return mFile.path().string(); }

@@ -15,14 +15,15 @@
 
 #include "FuzzTargets.h"
 #include "TestSupport.h"
-#include "preprocess/particles/ParticleWriter.h"
 #include "preprocess/BgeoTestWriter.h"
 #include "preprocess/ClassicBgeoTestWriter.h"
 #include "preprocess/GzipTestWriter.h"
+#include "preprocess/PdbTestWriter.h"
 #include "preprocess/PrtTestWriter.h"
 #include "preprocess/RealFlowTestWriter.h"
 #include "preprocess/VdbTestFiles.h"
 #include "preprocess/VtkTestWriter.h"
+#include "preprocess/particles/ParticleWriter.h"
 
 namespace flipscope {
 namespace {
@@ -205,7 +206,7 @@ TEST(FuzzCorpus, Write) {
     }
   }
 
-  // Houdini classic geometry, Krakatoa PRT, RealFlow .bin: small real files and the test
+  // Houdini classic geometry, Krakatoa PRT, RealFlow .bin, Maya .pdb: small real files and the test
   // writers' files with every feature; gzip: some of each gzipped, one in two members.
   for (const char* name : {"test.bgeo", "test.geo", "base.bgeo", "scatter.bgeo"})
     writeSeed(corpus / "classic_bgeo" / name, bytesOf(formats / "houdini-classic" / name));
@@ -233,6 +234,11 @@ TEST(FuzzCorpus, Write) {
   writeSeed(corpus / "realflow_bin" / "v12.bin", v12);
   writeSeed(corpus / "realflow_bin" / "v9.bin", testing::makeRealFlowBin(9, 2, testing::kRealFlowTail5));
   writeSeed(corpus / "realflow_bin" / "v4.bin", testing::makeRealFlowBin(4, 2, ""));
+  writeSeed(corpus / "pdb" / "test.pdb", bytesOf(formats / "maya-pdb" / "test.pdb"));
+  const std::string writtenPdb = testing::makePdb(
+      {{"position", 1, 3}, {"velocity", 1, 3}, {"life", 2, 2}, {"id", 3, 1}, {"flags", 4, 1}, {"owner", 5, 1}}, 5,
+      true);
+  writeSeed(corpus / "pdb" / "every_type_64.pdb", writtenPdb);
   auto text = [](const fs::path& path) {
     std::ifstream in(path, std::ios::binary);
     return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -241,6 +247,7 @@ TEST(FuzzCorpus, Write) {
   writeSeed(corpus / "gzip" / "le_v.ply.gz", testing::gzip(text(corpus / "ply" / "le_v.ply"), 2));
   writeSeed(corpus / "gzip" / "types.prt.gz", testing::gzip(typesPrt));
   writeSeed(corpus / "gzip" / "v12.bin.gz", testing::gzip(v12));
+  writeSeed(corpus / "gzip" / "every_type_64.pdb.gz", testing::gzip(writtenPdb));
   writeSeed(corpus / "gzip" / "written.bgeo.gz.gz", testing::gzip(testing::gzip(writtenBgeo)));
 
   // OpenVDB files: every codec, compression and layout (compact: a few KB each), and Mantaflow.

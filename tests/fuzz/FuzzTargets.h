@@ -9,7 +9,8 @@
 //   vtk, vtu                the same, with every attribute
 //   bgeo, bgeo_sc           a Houdini .bgeo or .geo (by content), and one in the scf1 container
 //   classic_bgeo, prt,      a particle file, read with every attribute: Houdini classic
-//   realflow_bin, gzip      geometry, Krakatoa PRT, RealFlow .bin, and any of them gzipped
+//   realflow_bin, pdb,      geometry, Krakatoa PRT, RealFlow .bin, Maya .pdb, and any of them
+//   gzip                    gzipped
 //   store_header            store.fsh (parsed as is, then again with its checksum made right)
 //   frame_index             u32 n, store.fsh (n bytes), then a frame file; the index is read as
 //                           is and again with its checksum made right, then every brick decoded
@@ -113,6 +114,7 @@ inline Result bgeoSc(std::span<const std::byte> input) { return readParticles("f
 inline Result classicBgeo(std::span<const std::byte> input) { return readParticles("fuzz.bgeo", input); }
 inline Result prt(std::span<const std::byte> input) { return readParticles("fuzz.prt", input); }
 inline Result realFlowBin(std::span<const std::byte> input) { return readParticles("fuzz.bin", input); }
+inline Result pdb(std::span<const std::byte> input) { return readParticles("fuzz.pdb", input); }
 inline Result gzip(std::span<const std::byte> input) { return readParticles("fuzz.gz", input); }
 
 /// Overwrites the last 8 bytes with the checksum of the bytes before them.
@@ -267,6 +269,7 @@ inline constexpr Target kTargets[] = {
     {"classic_bgeo", classicBgeo},
     {"prt", prt},
     {"realflow_bin", realFlowBin},
+    {"pdb", pdb},
     {"gzip", gzip},
     {"store_header", storeHeader},
     {"frame_index", frameIndex},

@@ -38,7 +38,7 @@ fuzz_one() {
 names=""
 running=0
 for pair in vdb_points:VdbPoints ply:Ply raw:Raw vtk:Vtk vtu:Vtu bgeo:Bgeo bgeo_sc:BgeoSc classic_bgeo:ClassicBgeo \
-  prt:Prt realflow_bin:RealFlow gzip:Gzip store_header:StoreHeader frame_index:FrameIndex brick_payload:BrickPayload \
+  prt:Prt realflow_bin:RealFlow pdb:Pdb gzip:Gzip store_header:StoreHeader frame_index:FrameIndex brick_payload:BrickPayload \
   camera:Camera; do
   name=${pair%%:*}
   names="$names $name"

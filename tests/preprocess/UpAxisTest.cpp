@@ -1,5 +1,5 @@
 // The scene's up axis (store version 6, StoreHeader::upAxis): what the input files' conventions
-// say (Blender's fluid caches z, Houdini and RealFlow y, others nothing), what `--up` asks,
+// say (Blender's fluid caches z, Houdini, RealFlow and Maya y, others nothing), what `--up` asks,
 // what an append keeps, and the store header's field, round trip and damage.
 #include <gtest/gtest.h>
 
@@ -40,6 +40,7 @@ TEST(UpAxis, FilesSayWhatTheirConventionsImply) {
   EXPECT_EQ(openParticleFile(kData / "formats" / "houdini-classic" / "test.bgeo")->upAxis(), UpAxis::Y);
   EXPECT_EQ(openParticleFile(kData / "formats" / "houdini-bgeo-sc" / "labs_star.1.bgeo.sc")->upAxis(), UpAxis::Y);
   EXPECT_EQ(openParticleFile(kData / "formats" / "realflow-bin" / "Circle01_00000.bin")->upAxis(), UpAxis::Y);
+  EXPECT_EQ(openParticleFile(kData / "formats" / "maya-pdb" / "test.pdb")->upAxis(), UpAxis::Y);
   TempDir dir("up-axis-files");
   EXPECT_EQ(openParticleFile(writePly(dir / "a.ply"))->upAxis(), UpAxis::Unknown);
 }
