@@ -40,6 +40,8 @@ constexpr std::int32_t kMagic = 670;
 constexpr std::size_t kIoHeaderBytes = 6;
 constexpr std::size_t kMaxNameBytes = 1024;  ///< a longer name is damage
 constexpr std::size_t kDecodeBytes = std::size_t(1) << 20;
+/// A particle's values in one channel, at most (a larger count is damage): 256 K reals.
+constexpr std::uint32_t kMaxParticleBytes = std::uint32_t(1) << 20;
 
 /// The struct sizes of one pointer width.
 struct PdbLayout {
@@ -136,15 +138,17 @@ std::optional<PdbContents> walkChannels(InputFile& file, const PdbLayout& layout
     }
     channel.particleBytes = number(dataAt + 4, std::uint32_t(0));
     const std::uint32_t n = channel.particleBytes;
-    const bool sized = channel.type == kVector ? n == 12
+    const bool sized = n > kMaxParticleBytes                            ? false
+                       : channel.type == kVector                        ? n == 12
                        : channel.type == kReal || channel.type == kLong ? n > 0 && n % 4 == 0
-                       : channel.type == kChar ? n > 0
-                                                : channel.type == kPointer;
+                       : channel.type == kChar                          ? n > 0
+                                                                        : channel.type == kPointer;
     if (!sized) {
       error = named + " at byte " + std::to_string(at) + ": " +
               (channel.type < kVector || channel.type > kPointer
                    ? std::string("not a channel type (1 vector, 2 real, 3 long, 4 char, 5 pointer)")
-                   : std::to_string(n) + " bytes a particle do not fit its type");
+                   : std::to_string(n) + " bytes a particle do not fit its type" +
+                         (n > kMaxParticleBytes ? " (at most 1 MiB)" : ""));
       return std::nullopt;
     }
     channel.offset = dataAt + layout.dataHeaderBytes;

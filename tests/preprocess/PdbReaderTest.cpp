@@ -3,6 +3,7 @@
 // writer, recognition by content, clear refusals, damage.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 
 #include "DamageTestSupport.h"
@@ -130,6 +131,13 @@ TEST(PdbReader, RefusalsSayWhatIsWrong) {
   std::string badType = good;
   badType[60 + 6 + 4] = 9;  // the first channel's type (32-bit layout)
   expectFileError([&] { openBytes("e.pdb", badType); }, {"e.pdb", "channel 0 ('position', type 9)", "not a channel type"});
+  // A particle count of 0 leaves any size of values room in the file: the size is bounded still.
+  std::string huge = makePdb({{"position", 1, 3}, {"flags", 4, 1}}, 0);
+  const std::uint32_t bytes = 0xffffffffu;
+  std::memcpy(huge.data() + huge.size() - 20 + 4, &bytes, 4);  // the last data header's bytes a particle
+  expectFileError(
+      [&] { openBytes("f.pdb", huge); },
+      {"f.pdb", "channel 1 ('flags', char)", "4294967295 bytes a particle do not fit its type (at most 1 MiB)"});
 }
 
 TEST(PdbReader, TruncatedAtEveryLengthIsRefused) {
