@@ -82,6 +82,22 @@ std::string typeName(std::int32_t type) {
   return "type " + std::to_string(type);
 }
 
+/// Whether `bytes` a particle hold whole values of channel type `type` (any for pointers).
+bool fitsType(std::int32_t type, std::uint32_t bytes) {
+  switch (type) {
+    case kVector:
+      return bytes == 12;
+    case kReal:
+    case kLong:
+      return bytes > 0 && bytes % 4 == 0;
+    case kChar:
+      return bytes > 0;
+    case kPointer:
+      return true;
+  }
+  return false;
+}
+
 /// The channels of `file` under `layout`, or what is wrong with them under it (`error`).
 std::optional<PdbContents> walkChannels(InputFile& file, const PdbLayout& layout, std::string& error) {
   const std::uint64_t size = file.size();
@@ -138,11 +154,7 @@ std::optional<PdbContents> walkChannels(InputFile& file, const PdbLayout& layout
     }
     channel.particleBytes = number(dataAt + 4, std::uint32_t(0));
     const std::uint32_t n = channel.particleBytes;
-    const bool sized = n > kMaxParticleBytes                            ? false
-                       : channel.type == kVector                        ? n == 12
-                       : channel.type == kReal || channel.type == kLong ? n > 0 && n % 4 == 0
-                       : channel.type == kChar                          ? n > 0
-                                                                        : channel.type == kPointer;
+    const bool sized = n <= kMaxParticleBytes && fitsType(channel.type, n);
     if (!sized) {
       error = named + " at byte " + std::to_string(at) + ": " +
               (channel.type < kVector || channel.type > kPointer
