@@ -27,7 +27,6 @@
 
 #include <algorithm>
 #include <bit>
-#include <cctype>
 #include <charconv>
 #include <cstring>
 #include <optional>
@@ -491,8 +490,7 @@ bool endsWith(std::string_view text, std::string_view suffix) {
 }  // namespace
 
 std::unique_ptr<ParticleWriter> createBgeoWriter(const std::filesystem::path& path, const WriteOptions& options) {
-  std::string name = path.filename().string();
-  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  std::string name = asciiLower(path.filename().string());
   if (endsWith(name, ".gz"))
     throw FileError(path, "cannot write gzip-compressed Houdini geometry: write .bgeo.sc (Blosc) or .bgeo instead");
   const bool scf = endsWith(name, ".sc");

@@ -26,15 +26,16 @@ std::string_view valueTypeName(ValueType type) {
   return "unknown";
 }
 
+std::string detail::asciiLower(std::string_view text) {
+  std::string out(text);
+  for (char& c : out) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
 std::optional<std::size_t> detail::velocityAttributeByName(const std::vector<AttributeDesc>& attributes) {
-  auto lower = [](std::string_view text) {
-    std::string out(text);
-    for (char& c : out) c = char(std::tolower(static_cast<unsigned char>(c)));
-    return out;
-  };
   for (std::string_view name : {"velocity", "velocities", "vel", "v"})
     for (std::size_t i = 0; i < attributes.size(); ++i)
-      if (attributes[i].arity == 3 && lower(attributes[i].name) == name) return i;
+      if (attributes[i].arity == 3 && asciiLower(attributes[i].name) == name) return i;
   return std::nullopt;
 }
 

@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cctype>
 
 #include "core/Error.h"
 #include "preprocess/particles/ParticleFormats.h"
@@ -75,11 +74,7 @@ const std::vector<ContainerFormat>& containerTable() {
   return table;
 }
 
-std::string lowerName(const std::filesystem::path& path) {
-  std::string name = path.filename().string();
-  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  return name;
-}
+std::string lowerName(const std::filesystem::path& path) { return detail::asciiLower(path.filename().string()); }
 
 bool endsWith(std::string_view text, std::string_view suffix) {
   return text.size() >= suffix.size() && text.substr(text.size() - suffix.size()) == suffix;

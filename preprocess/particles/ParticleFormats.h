@@ -9,6 +9,8 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "preprocess/particles/InputFile.h"
@@ -76,6 +78,9 @@ std::unique_ptr<ParticleSource> openRealFlowParticles(InputFile file, const Read
 /// Maya particle disk cache .pdb, little-endian, written by a 32- or 64-bit build (PdbParticles.cpp).
 bool isPdb(std::span<const std::byte> head);
 std::unique_ptr<ParticleSource> openPdbParticles(InputFile file, const ReadOptions& options);
+
+/// `text` with A-Z as a-z (names, keywords and extensions compare case-insensitively).
+std::string asciiLower(std::string_view text);
 
 /// The velocity among `attributes` of a format that does not name it (VTK, Maya PDB): the
 /// 3-component one named velocity, velocities, vel or v (in that order of preference,

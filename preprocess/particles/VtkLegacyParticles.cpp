@@ -44,12 +44,6 @@ struct LegacyType {
   bool bit = false;
 };
 
-std::string lower(std::string_view text) {
-  std::string out(text);
-  for (char& c : out) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return out;
-}
-
 std::optional<LegacyType> legacyType(const std::string& name) {
   struct Entry {
     std::string_view name;
@@ -135,7 +129,7 @@ class LayoutParser {
     mLayout.version = std::string(version.substr(0, 20));
     std::from_chars(version.data(), version.data() + version.size(), mLayout.major);
     mLayout.title = std::string(mCursor.line(kMaxLineBytes, "the title line (line 2)"));
-    std::string format = lower(mCursor.word(kMaxWordBytes, "the format line (line 3)"));
+    std::string format = asciiLower(mCursor.word(kMaxWordBytes, "the format line (line 3)"));
     if (format != "ascii" && format != "binary")
       fail("line 3: expected ASCII or BINARY, found '" + format.substr(0, 40) + "'");
     mLayout.binary = format == "binary";
@@ -145,7 +139,7 @@ class LayoutParser {
       if (word.empty()) break;
       mKeywordOffset = mCursor.offset() - word.size();
       mKeywordText = std::string(word.substr(0, 40));
-      section(lower(word));
+      section(asciiLower(word));
     }
     if (mLayout.dataset.empty()) fail("no DATASET in the file: it holds no points");
     if (!mLayout.hasPoints) fail("the " + mLayout.dataset + " dataset has no POINTS: no particles");
@@ -179,7 +173,7 @@ class LayoutParser {
     return value;
   }
   LegacyType type(const char* what) {
-    std::string name = lower(word(what));
+    std::string name = asciiLower(word(what));
     if (auto type = legacyType(name)) return *type;
     if (name == "string" || name == "utf8_string" || name == "variant")
       fail(at() + " holds " + name + " values, which flipscope does not read");
@@ -328,7 +322,7 @@ class LayoutParser {
         std::string name = word("a field array name");
         mKeywordOffset = mCursor.offset() - name.size();
         mKeywordText = "FIELD array '" + decodeName(name).substr(0, 40) + "'";
-        if (lower(name) == "null_array") continue;
+        if (asciiLower(name) == "null_array") continue;
         const std::uint64_t components = arity("component count");
         const std::uint64_t tuples = count("tuple count");
         const LegacyType t = type("array type");
