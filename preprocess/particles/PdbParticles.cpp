@@ -60,7 +60,7 @@ struct PdbChannel {
   std::int32_t type = 0;
   std::uint32_t particleBytes = 0;  ///< bytes of values a particle
   std::uint64_t offset = 0;         ///< of the first particle's values
-  AttributeDesc desc;               ///< as exposed (not for pointers)
+  AttributeDesc desc;               ///< its values' type and arity (pointers: not exposed, never read)
 };
 
 struct PdbContents {
@@ -251,8 +251,10 @@ class PdbReader final : public ParticleSource {
     const FloatStreams streams{mStreams.size(), mHasVelocity, mVelocityStream, mColumnStreams};
     fillFromFloatStreams(
         chunk, std::size_t(n), streams, mExposed, mSelected,
-        [&](std::size_t stream) { return channelArity(mPdb.channels[mStreams[stream]]); },
-        [&](std::size_t stream, std::size_t count, float* out) { readChannel(mPdb.channels[mStreams[stream]], count, out); });
+        [&](std::size_t stream) { return mPdb.channels[mStreams[stream]].desc.arity; },
+        [&](std::size_t stream, std::size_t count, float* out) {
+          readChannel(mPdb.channels[mStreams[stream]], count, out);
+        });
     mNext += n;
     return true;
   }
@@ -261,8 +263,6 @@ class PdbReader final : public ParticleSource {
 
  private:
   FileError fail(const std::string& what) const { return FileError(mFile.path(), "Maya .pdb: " + what); }
-
-  static int channelArity(const PdbChannel& c) { return c.type == kVector ? 3 : c.desc.arity; }
 
   /// The stream of channel `channel`, shared by every use of it.
   std::size_t addStream(std::size_t channel) {
@@ -274,8 +274,7 @@ class PdbReader final : public ParticleSource {
 
   /// The values of particles [mNext, mNext + count) of `c` into `out`.
   void readChannel(const PdbChannel& c, std::size_t count, float* out) {
-    const int arity = channelArity(c);
-    const ValueType type = c.type == kVector ? ValueType::Float32 : c.desc.type;
+    const int arity = c.desc.arity;
     const std::size_t perPiece = std::max<std::size_t>(1, kDecodeBytes / c.particleBytes);
     for (std::size_t done = 0; done < count;) {
       const std::size_t particles = std::min(perPiece, count - done);
@@ -284,7 +283,7 @@ class PdbReader final : public ParticleSource {
       if (mFile.readAt(at, mBytes.data(), mBytes.size()) != mBytes.size())
         throw fail("the file ends inside channel '" + c.name + "' (byte " + std::to_string(at + mBytes.size()) +
                    "; it shrank since it was opened?)");
-      decodeColumn(type, ByteOrder::Little, mBytes.data(), c.particleBytes, arity, particles,
+      decodeColumn(c.desc.type, ByteOrder::Little, mBytes.data(), c.particleBytes, arity, particles,
                    out + done * std::size_t(arity));
       done += particles;
     }
