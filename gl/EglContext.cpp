@@ -260,6 +260,7 @@ EglContext EglContext::create() {
     glEnable(GL_DEBUG_OUTPUT_SYNCHRONOUS);
     glDebugMessageCallback(printDebugMessage, nullptr);
 #endif
+    result.mPassedOver = std::move(failures);
     return result;
   }
   std::string reason = "no EGL display gives an OpenGL 4.5 core context";
@@ -267,12 +268,24 @@ EglContext EglContext::create() {
   throw Unavailable(reason);
 }
 
+std::vector<std::string> listEglDevices() {
+  if (!epoxy_has_egl()) return {"no EGL: libEGL.so.1 could not be loaded"};
+  const char* clientExtensions = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
+  if (!clientExtensions) eglGetError();
+  std::vector<std::string> failures, lines;
+  for (const DeviceCandidate& device : enumerateDevices(clientExtensions, failures))
+    lines.push_back(device.candidate.label);
+  lines.insert(lines.end(), failures.begin(), failures.end());
+  return lines;
+}
+
 EglContext::~EglContext() { reset(); }
 
 EglContext::EglContext(EglContext&& other) noexcept
     : mDisplay(std::exchange(other.mDisplay, EGL_NO_DISPLAY)),
       mContext(std::exchange(other.mContext, EGL_NO_CONTEXT)),
-      mPlatform(std::move(other.mPlatform)) {}
+      mPlatform(std::move(other.mPlatform)),
+      mPassedOver(std::move(other.mPassedOver)) {}
 
 EglContext& EglContext::operator=(EglContext&& other) noexcept {
   if (this != &other) {
@@ -280,6 +293,7 @@ EglContext& EglContext::operator=(EglContext&& other) noexcept {
     mDisplay = std::exchange(other.mDisplay, EGL_NO_DISPLAY);
     mContext = std::exchange(other.mContext, EGL_NO_CONTEXT);
     mPlatform = std::move(other.mPlatform);
+    mPassedOver = std::move(other.mPassedOver);
   }
   return *this;
 }

@@ -15,6 +15,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace flipscope::gl {
 
@@ -43,6 +44,8 @@ class EglContext {
   std::string renderer() const;
   /// Which display was used: "device", "surfaceless" or "default".
   const std::string& platform() const { return mPlatform; }
+  /// Why each display tried before this one (and each platform not offered) was passed over.
+  const std::vector<std::string>& passedOver() const { return mPassedOver; }
   bool isValid() const { return mContext != EGL_NO_CONTEXT; }
   EGLDisplay display() const { return mDisplay; }
   EGLContext context() const { return mContext; }
@@ -53,7 +56,13 @@ class EglContext {
   EGLDisplay mDisplay = EGL_NO_DISPLAY;
   EGLContext mContext = EGL_NO_CONTEXT;
   std::string mPlatform;
+  std::vector<std::string> mPassedOver;
 };
+
+/// The devices of the EGL device platform, in the order create() tries them, one line each
+/// ("device platform, device 0 (NVIDIA /dev/dri/card1)"), then why any could not be listed or
+/// opened; one line saying why when EGL itself is missing.
+std::vector<std::string> listEglDevices();
 
 /// "GL_VENDOR / GL_RENDERER / GL_VERSION" of the context current on this thread (any context:
 /// EGL, or a window's GLX); one must be current.

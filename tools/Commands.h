@@ -33,6 +33,7 @@ void addBenchCommand(CLI::App& app);  // creates `bench` and calls the ones belo
 void addRenderCommand(CLI::App& app);
 void addDemoCommand(CLI::App& app);
 void addViewCommand(CLI::App& app);
+void addDevicesCommand(CLI::App& app);
 void addFarmCommand(CLI::App& app);  // farm convert | render | status, and the tasks' bounds, finalize
 
 // `flipscope bench <stage>`: each in its own file (tools/Bench<Stage>.cpp).

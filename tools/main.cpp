@@ -13,14 +13,15 @@
 namespace {
 
 /// Whether the parsed command (its subcommand path, as "farm status") is one that allocates
-/// large buffers: all but info, inspect and the farm's submission, status and finalize.
+/// large buffers: all but info, inspect, devices and the farm's submission, status and finalize.
 bool allocatesLargeBuffers(const CLI::App& app) {
   std::string path;
   for (const CLI::App* c = &app; !c->get_subcommands().empty();) {
     c = c->get_subcommands().front();
     path += (path.empty() ? "" : " ") + c->get_name();
   }
-  for (const char* light : {"info", "inspect", "farm convert", "farm render", "farm status", "farm finalize"})
+  for (const char* light :
+       {"info", "inspect", "devices", "farm convert", "farm render", "farm status", "farm finalize"})
     if (path == light) return false;
   return true;
 }
@@ -42,6 +43,7 @@ int main(int argc, char** argv) {
   tools::addDemoCommand(app);
   tools::addViewCommand(app);
   tools::addFarmCommand(app);
+  tools::addDevicesCommand(app);
   // Huge pages where they fill faster (core/HugePageAdvice.h), chosen once the command line has
   // parsed (not for --help, --version or a usage error) and before the command runs, for the
   // commands that allocate large buffers: not for those that read headers or submit jobs.

@@ -47,3 +47,37 @@ TEST(RenderDeviceCli, TheFastCpuDeviceRendersTheReferencesImage) {
 }
 
 }  // namespace
+
+namespace {
+
+std::string lineStartingWith(const std::string& text, const std::string& prefix) {
+  for (std::size_t at = 0; at < text.size();) {
+    std::size_t end = text.find('\n', at);
+    if (end == std::string::npos) end = text.size();
+    if (text.compare(at, prefix.size(), prefix) == 0) return text.substr(at, end - at);
+    at = end + 1;
+  }
+  return {};
+}
+
+// `devices` names what --device gpu gets and what auto picks: the CPU ray-caster, with its
+// reason, whenever OpenGL is missing or software (llvmpipe here), else OpenGL.
+TEST(RenderDeviceCli, DevicesNamesTheOpenGlContextAndWhatAutoPicks) {
+  const auto run = runFlipscope("devices");
+  ASSERT_EQ(run.exitCode, 0) << run.output;
+  EXPECT_NE(run.output.find("EGL devices:\n"), std::string::npos) << run.output;
+  const std::string gpu = lineStartingWith(run.output, "--device gpu: ");
+  const std::string automatic = lineStartingWith(run.output, "--device auto: ");
+  ASSERT_FALSE(gpu.empty()) << run.output;
+  ASSERT_FALSE(automatic.empty()) << run.output;
+  const bool hardware = gpu.find("unavailable") == std::string::npos && gpu.find("llvmpipe") == std::string::npos &&
+                        gpu.find("softpipe") == std::string::npos;
+  if (hardware) {
+    EXPECT_EQ(automatic.rfind("--device auto: OpenGL (", 0), 0u) << run.output;
+  } else {
+    EXPECT_EQ(automatic.rfind("--device auto: CPU (", 0), 0u) << run.output;
+    EXPECT_NE(automatic.find(", because "), std::string::npos) << run.output;
+  }
+}
+
+}  // namespace
