@@ -6,6 +6,7 @@
 #include "GlTestSupport.h"
 
 #include <cstring>
+#include <string>
 
 #include "RaycastScenes.h"
 #include "TestSupport.h"
@@ -34,10 +35,13 @@ std::unique_ptr<FrameRenderer> gpuRenderer(const BrickStore& store, const Render
   if (!var) FLIPSCOPE_SKIP_WITHOUT_GL(skip_##var)
 
 /// Compares GPU and CPU rays: the same hit/miss decision on all but `maxMismatch` pixels, and
-/// on pixels both hit, distances within 1e-4 relative and attributes equal.
+/// on pixels both hit, distances within 1e-4 relative and attributes within 1e-5 relative on
+/// all but 1 in 200. Not bit for bit: a hardware GPU rounds differently (fused multiply-adds),
+/// so an NVIDIA H200 gave attributes 1 ulp apart and distances a few ulps apart.
 void expectSameImage(const RenderResult& gpu, const RenderResult& cpu, std::size_t maxMismatch) {
   ASSERT_EQ(gpu.hits.size(), cpu.hits.size());
   std::size_t mismatch = 0, both = 0, far = 0;
+  std::string examples;
   for (std::size_t i = 0; i < gpu.hits.size(); ++i) {
     const RayHit& g = gpu.hits[i];
     const RayHit& c = cpu.hits[i];
@@ -48,14 +52,16 @@ void expectSameImage(const RenderResult& gpu, const RenderResult& cpu, std::size
     }
     if (g.status != kRayHit) continue;
     ++both;
-    if (std::abs(g.t - c.t) > 1e-4f * std::max(1.0f, c.t) || g.normal.w != c.normal.w) {
+    if (std::abs(g.t - c.t) > 1e-4f * std::max(1.0f, c.t) ||
+        std::abs(g.normal.w - c.normal.w) > 1e-5f * std::max(1.0f, std::abs(c.normal.w))) {
       if (far++ < 5)
-        ADD_FAILURE() << "pixel " << i << ": t " << g.t << " / " << c.t << ", attribute " << g.normal.w << " / "
-                      << c.normal.w << ", brick " << g.brickIndex << " / " << c.brickIndex;
+        examples += "\n  pixel " + std::to_string(i) + ": t " + std::to_string(g.t) + " / " + std::to_string(c.t) +
+                    ", attribute " + std::to_string(g.normal.w) + " / " + std::to_string(c.normal.w) + ", brick " +
+                    std::to_string(g.brickIndex) + " / " + std::to_string(c.brickIndex);
     }
   }
   EXPECT_LE(mismatch, maxMismatch) << "hit/miss disagreements";
-  EXPECT_LE(far, both / 200 + 1) << "of " << both << " pixels both hit";
+  EXPECT_LE(far, both / 200 + 1) << "of " << both << " pixels both hit, apart:" << examples;
 }
 
 TEST(GpuRaycaster, BallRendersAsDiskWithAnalyticDepth) {
