@@ -81,6 +81,7 @@ struct FramePipeline::Stages {
   bool thickness = false;         ///< the ray-caster traces the thickness (liquid shading)
   bool litSpheres = false;        ///< spheres shading: the image's normals are the spheres'
   bool shadedReadOut = false;     ///< CPU: `shaded`'s pixels moved to the output since shade()
+  std::vector<glm::vec4> downloaded[4];  ///< GPU: the images readOutput() reads back, kept
   /// The smoothed depth: the G-buffer itself when the filter keeps the depth (not run).
   ScreenImage smoothedDepth() const { return filter->keepsDepth() ? gbuffer : smoothed; }
 };
@@ -279,13 +280,12 @@ const FrameOutput& FramePipeline::readOutput() {
     if (!s.shadedReadOut) cpu->exchangePixels(s.shaded, image.rgba);
     s.shadedReadOut = true;
   } else {
-    image.rgba = device.download(s.shaded);
+    device.downloadInto(s.shaded, image.rgba);
   }
-  std::vector<glm::vec4> downloaded[4];
   auto read = [&](ScreenImage handle, int slot) -> std::span<const glm::vec4> {
     if (cpu) return cpu->pixels(handle);
-    downloaded[slot] = device.download(handle);
-    return downloaded[slot];
+    device.downloadInto(handle, s.downloaded[slot]);
+    return s.downloaded[slot];
   };
   const auto gbuffer = read(s.gbuffer, 0);
   const auto smoothed = read(s.smoothedDepth(), 1);

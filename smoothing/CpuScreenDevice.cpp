@@ -83,9 +83,9 @@ void CpuScreenDevice::upload(ScreenImage handle, std::span<const glm::vec4> data
   std::copy(data.begin(), data.end(), image.data.begin());
 }
 
-std::vector<glm::vec4> CpuScreenDevice::download(ScreenImage handle) {
-  const auto pixels = read(handle);
-  return {pixels.begin(), pixels.end()};
+void CpuScreenDevice::downloadInto(ScreenImage handle, std::vector<glm::vec4>& pixels) {
+  const auto source = read(handle);
+  pixels.assign(source.begin(), source.end());
 }
 
 void CpuScreenDevice::run(const ScreenPass& pass, const void* params, std::size_t,

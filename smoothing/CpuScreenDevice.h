@@ -19,7 +19,7 @@ class CpuScreenDevice : public ScreenDevice {
   std::vector<ScreenImage> createFrameImages(std::size_t count) override;
   ScreenImage createFixedImage(std::size_t elements) override;
   void upload(ScreenImage image, std::span<const glm::vec4> data) override;
-  std::vector<glm::vec4> download(ScreenImage image) override;
+  void downloadInto(ScreenImage image, std::vector<glm::vec4>& pixels) override;
   void clear(ScreenImage image) override;
   void copy(ScreenImage from, ScreenImage to) override;
   void run(const ScreenPass& pass, const void* params, std::size_t paramBytes,

@@ -75,12 +75,11 @@ void GpuScreenDevice::upload(ScreenImage handle, std::span<const glm::vec4> data
   if (!data.empty()) target.owned.upload(0, data.data(), data.size_bytes());
 }
 
-std::vector<glm::vec4> GpuScreenDevice::download(ScreenImage handle) {
+void GpuScreenDevice::downloadInto(ScreenImage handle, std::vector<glm::vec4>& pixels) {
   const Image& source = image(handle);
-  std::vector<glm::vec4> data(source.elements);
+  pixels.resize(source.elements);
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  if (!data.empty()) source.buffer().download(0, data.size() * 16, data.data());
-  return data;
+  if (!pixels.empty()) source.buffer().download(0, pixels.size() * sizeof(glm::vec4), pixels.data());
 }
 
 const gl::Program& GpuScreenDevice::program(const ScreenPass& pass) {

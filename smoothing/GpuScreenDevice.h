@@ -28,7 +28,7 @@ class GpuScreenDevice : public ScreenDevice {
   /// ray-caster's hit buffer); it must stay alive and frame-sized while passes read it.
   ScreenImage adoptFrameBuffer(const gl::Buffer* buffer, std::uint32_t perPixel);
   void upload(ScreenImage image, std::span<const glm::vec4> data) override;
-  std::vector<glm::vec4> download(ScreenImage image) override;
+  void downloadInto(ScreenImage image, std::vector<glm::vec4>& pixels) override;
   void clear(ScreenImage image) override;
   void copy(ScreenImage from, ScreenImage to) override;
   void run(const ScreenPass& pass, const void* params, std::size_t paramBytes,

@@ -66,7 +66,14 @@ class ScreenDevice {
   virtual ScreenImage createFixedImage(std::size_t elements) = 0;
   /// Writes the whole image (data.size() equals its element count).
   virtual void upload(ScreenImage image, std::span<const glm::vec4> data) = 0;
-  virtual std::vector<glm::vec4> download(ScreenImage image) = 0;
+  /// Reads the whole image into `pixels`, resized to its element count; a vector kept from
+  /// frame to frame keeps its memory (no fresh pages to fault in for each frame's read-back).
+  virtual void downloadInto(ScreenImage image, std::vector<glm::vec4>& pixels) = 0;
+  std::vector<glm::vec4> download(ScreenImage image) {
+    std::vector<glm::vec4> pixels;
+    downloadInto(image, pixels);
+    return pixels;
+  }
   /// Sets every element to zero.
   virtual void clear(ScreenImage image) = 0;
   /// Copies `from` into `to` (same element count).

@@ -24,7 +24,7 @@ class ForwardingScreenDevice : public ScreenDevice {
   ScreenImage createFrameImage(std::uint32_t perPixel) override { return mInner.createFrameImage(perPixel); }
   ScreenImage createFixedImage(std::size_t elements) override { return mInner.createFixedImage(elements); }
   void upload(ScreenImage image, std::span<const glm::vec4> data) override { mInner.upload(image, data); }
-  std::vector<glm::vec4> download(ScreenImage image) override { return mInner.download(image); }
+  void downloadInto(ScreenImage image, std::vector<glm::vec4>& pixels) override { mInner.downloadInto(image, pixels); }
   void clear(ScreenImage image) override { mInner.clear(image); }
   void copy(ScreenImage from, ScreenImage to) override { mInner.copy(from, to); }
   void run(const ScreenPass& pass, const void* params, std::size_t paramBytes, std::initializer_list<ScreenImage> inputs,
