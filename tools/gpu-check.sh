@@ -15,6 +15,10 @@ step machine
 step devices
 $fs devices 2>&1 | tee -a "$log"
 grep -q "auto: OpenGL" "$log" || { step "no hardware OpenGL: --device auto would use the CPU; stopping"; exit 1; }
+# The GPU's clocks and power through the rest (a warm frame's time depends on them).
+nvidia-smi dmon -s pc -o T >"$out/dmon.txt" 2>&1 &
+dmon=$!
+trap 'kill $dmon 2>/dev/null' EXIT
 for t in $(find build/tests -name 'test_*_gl' -type f | sort); do
   step "$t"
   timeout 300 "$t" --gtest_brief=1 2>&1 | tail -30 | tee -a "$log"
