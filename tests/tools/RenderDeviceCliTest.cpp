@@ -46,10 +46,6 @@ TEST(RenderDeviceCli, TheFastCpuDeviceRendersTheReferencesImage) {
   EXPECT_LE(apart, int(fast.size()) / 200);
 }
 
-}  // namespace
-
-namespace {
-
 std::string lineStartingWith(const std::string& text, const std::string& prefix) {
   for (std::size_t at = 0; at < text.size();) {
     std::size_t end = text.find('\n', at);
