@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <fstream>
 
+#include "core/Elapsed.h"
 #include "core/Error.h"
 
 namespace flipscope {
@@ -28,7 +29,7 @@ double touchFresh(std::size_t bytes, bool advised) {
   const std::size_t page = std::size_t(::sysconf(_SC_PAGESIZE));
   const auto start = std::chrono::steady_clock::now();
   for (std::size_t i = 0; i < bytes; i += page) begin[i] = 1;
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds = secondsSince(start);
   ::munmap(map, mapped);
   return seconds;
 }

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/Elapsed.h"
+
 namespace flipscope {
 
 Progress::Progress(std::string label, std::uint64_t total, std::string unit, Mode mode)
@@ -27,9 +29,7 @@ void Progress::setLabel(std::string label) {
   mLabel = std::move(label);
 }
 
-double Progress::elapsedSeconds() const {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - mStart).count();
-}
+double Progress::elapsedSeconds() const { return secondsSince(mStart); }
 
 std::string Progress::humanCount(double v) {
   const char* suffix = "";

@@ -10,6 +10,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "core/Elapsed.h"
 #include "core/Error.h"
 #include "raycast/CpuRaycaster.h"
 #include "raycast/RaycastTypes.h"
@@ -28,10 +29,6 @@ struct GBufferKernel : CpuScreenKernel {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
 const ScreenPass kHits{"GBufferHits.comp", "gbufferHits",
                        cpuScreenPass<glsl::GBufferKernel, &glsl::GBufferKernel::gbufferHits>};
 const ScreenPass kBlurThickness{"GBuffer.comp", "gbufferBlurThickness",

@@ -21,6 +21,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include "core/AtomicFile.h"
+#include "core/Elapsed.h"
 #include "core/Error.h"
 #include "preprocess/BrickBinning.h"
 #include "preprocess/DirectFile.h"
@@ -915,7 +916,7 @@ FrameReport convertOneFrame(ParticleSource& source, BrickStore& store, int frame
   report.bricks = std::uint32_t(index.bricks.size());
   report.storeBytes = index.fileBytes;
   report.spillBuckets = binner.spillBuckets();
-  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report.seconds = secondsSince(start);
   return report;
 }
 

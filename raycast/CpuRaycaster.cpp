@@ -7,6 +7,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "core/Elapsed.h"
 #include "core/Error.h"
 #include "raycast/CpuRaycastKernel.h"
 #include "raycast/NearSphereMask.h"
@@ -112,7 +113,7 @@ void CpuRaycaster::timedClassify(std::span<const std::uint32_t> slots, const Foa
     std::uint32_t* occupancy = &mPool.foamOccupancy[std::size_t(slots[i]) * layout.foamOccupancyWords()];
     for (std::uint32_t w = 0; w < layout.foamOccupancyWords(); ++w) occupancy[w] = kernel.fcOccupancyWord(slots[i], w);
   });
-  mLastClassifyMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  mLastClassifyMs = msSince(start);
 }
 
 std::vector<glm::uvec4> CpuRaycaster::readFoam(std::uint32_t slot) {
@@ -148,7 +149,7 @@ std::vector<std::uint32_t> CpuRaycaster::timedPass(
   std::vector<std::uint32_t> requests;
   for (std::size_t i = 0; i < brickCount; ++i)
     if (flags[i].load(std::memory_order_relaxed)) requests.push_back(std::uint32_t(i));
-  mLastTraceMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  mLastTraceMs = msSince(start);
   return requests;
 }
 

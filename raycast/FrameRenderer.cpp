@@ -10,6 +10,7 @@
 #include <glm/trigonometric.hpp>
 #include <glm/vector_relational.hpp>
 
+#include "core/Elapsed.h"
 #include "core/Error.h"
 #include "streaming/BrickMipmap.h"
 
@@ -17,9 +18,6 @@ namespace flipscope {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 /// Bricks advance() uploads (and classifies for foam) between two looks at its budget. The paper
 /// classifies batches of 256 (§3.5); fewer keep a slice short on the CPU reference.
 constexpr std::size_t kUploadBatch = 64;

@@ -5,10 +5,11 @@
 #include <chrono>
 #include <cstring>
 
+#include "core/Elapsed.h"
 #include "core/Error.h"
+#include "gl/ShaderSource.h"
 #include "raycast/CpuRaycaster.h"
 #include "raycast/TiledCpuRaycaster.h"
-#include "gl/ShaderSource.h"
 
 namespace flipscope {
 
@@ -156,8 +157,7 @@ void GpuRaycaster::classifyFoam(std::span<const std::uint32_t> slots, const Foam
   }
   mTimer.end();
   if (mSoftware) glFinish();
-  mLastClassifyMs = mSoftware ? std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()
-                              : mTimer.milliseconds();
+  mLastClassifyMs = mSoftware ? msSince(start) : mTimer.milliseconds();
 }
 
 std::vector<glm::uvec4> GpuRaycaster::readFoam(std::uint32_t slot) {
@@ -207,8 +207,7 @@ std::vector<std::uint32_t> GpuRaycaster::trace(const RaycastParams& params) {
   if (count) mRequests.download(4, count * 4, requests.data());
   std::sort(requests.begin(), requests.end());
   requests.erase(std::unique(requests.begin(), requests.end()), requests.end());
-  mLastTraceMs = mSoftware ? std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()
-                           : mTimer.milliseconds();
+  mLastTraceMs = mSoftware ? msSince(start) : mTimer.milliseconds();
   return requests;
 }
 

@@ -44,6 +44,12 @@ class TempDir {
   std::filesystem::path mPath;
 };
 
+/// A file of the Mantaflow sample (FLIPSCOPE_DATA_DIR/mantaflow-dam64): `folder` "data" holds the
+/// FLIP particles, "particles" the spray, foam and bubbles.
+inline std::filesystem::path mantaflowFile(const std::string& folder, const std::string& name) {
+  return std::filesystem::path(FLIPSCOPE_DATA_DIR) / "mantaflow-dam64" / folder / name;
+}
+
 struct CommandRun {
   int exitCode;
   std::string output;  ///< stdout and stderr together

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <memory>
 
+#include "core/Elapsed.h"
 #include "core/Error.h"
 
 namespace flipscope::tools {
@@ -47,7 +48,7 @@ DiskRead readUncached(const std::vector<std::filesystem::path>& files) {
     }
     ::close(fd);
   }
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.seconds = secondsSince(start);
   return result;
 }
 

@@ -14,6 +14,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/Elapsed.h"
 #include "core/Error.h"
 #include "core/Progress.h"
 #include "tools/BenchDisk.h"
@@ -41,7 +42,7 @@ double timed(const std::vector<std::string>& args) {
   argv.insert(argv.end(), args.begin(), args.end());
   const auto start = std::chrono::steady_clock::now();
   const farm::ProgramRun run = farm::runProgram(argv);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds = secondsSince(start);
   if (run.exitCode != 0) throw InputError("bench farm: flipscope " + args.front() + " failed:\n" + run.output);
   return seconds;
 }
@@ -55,7 +56,7 @@ double emptyArray(int tasks, const fs::path& dir) {
   const farm::ProgramRun submit =
       farm::runProgram({"sbatch", "--parsable", "--wait", "--array=0-" + std::to_string(tasks - 1), script.string()});
   if (submit.exitCode != 0) throw InputError("bench farm: sbatch of empty tasks failed: " + submit.output);
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return secondsSince(start);
 }
 
 void runBenchFarm(const BenchFarmArgs& a) {

@@ -3,13 +3,14 @@
 #include <chrono>
 #include <cstdio>
 
+#include "core/Elapsed.h"
 #include "core/Error.h"
 #include "core/Progress.h"
-#include "tools/ChildProcess.h"
-#include "tools/CliValues.h"
 #include "preprocess/SynthFluid.h"
 #include "preprocess/particles/ParticleSource.h"
 #include "preprocess/particles/ParticleWriter.h"
+#include "tools/ChildProcess.h"
+#include "tools/CliValues.h"
 
 namespace flipscope::tools {
 namespace {
@@ -18,10 +19,6 @@ namespace fs = std::filesystem;
 
 /// The fixed overhead beyond --mem that convert documents (README, Reliability).
 constexpr double kFixedOverheadMiB = 48;
-
-double secondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 /// Writes the synth frame as `path` unless it exists (not timed).
 void writeSynth(const fs::path& path, std::uint64_t particles) {

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/AtomicFile.h"
+#include "core/Elapsed.h"
 #include "core/Error.h"
 #include "core/ProcessMemory.h"
 #include "pipeline/FramePipeline.h"
@@ -27,8 +28,6 @@ struct FrameStageArgs {
   std::string statsFile;
   std::string image;
 };
-
-double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 void runStage(const FrameStageArgs& a) {
   keepHeapForReuse();  // core/ProcessMemory.h

@@ -19,16 +19,17 @@
 #include <memory>
 #include <thread>
 
+#include "core/Elapsed.h"
 #include "core/Error.h"
 #include "core/ProcessMemory.h"
 #include "preprocess/Convert.h"
-#include "preprocess/particles/ParticleWriter.h"
 #include "preprocess/SynthFluid.h"
+#include "preprocess/particles/ParticleWriter.h"
 #include "tools/BenchDisk.h"
 #include "tools/BenchFormats.h"
-#include "tools/JsonOutput.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
+#include "tools/JsonOutput.h"
 
 namespace flipscope::tools {
 namespace {
@@ -47,10 +48,6 @@ struct BenchPreprocessArgs {
   std::string formatMem = "64M";
   std::string outOfCoreMem = "256M";  ///< --mem of the out-of-core convert from disk
 };
-
-double secondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 /// Reads every file sequentially as fast as possible; returns bytes read.
 std::uint64_t readRaw(const std::vector<fs::path>& files) {

@@ -13,27 +13,26 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "core/Elapsed.h"
 #include "core/Error.h"
-#include "tools/ChildProcess.h"
-#include "preprocess/Convert.h"
-#include "preprocess/particles/ParticleWriter.h"
-#include "preprocess/SynthFluid.h"
-#include "raycast/GpuRaycaster.h"
 #include "pipeline/FramePipeline.h"
+#include "preprocess/Convert.h"
+#include "preprocess/SynthFluid.h"
+#include "preprocess/particles/ParticleWriter.h"
+#include "raycast/GpuRaycaster.h"
 #include "tools/BenchFoam.h"
 #include "tools/BenchFrameStage.h"
-#include "tools/EmbreePeer.h"
-#include "tools/JsonOutput.h"
+#include "tools/ChildProcess.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
+#include "tools/EmbreePeer.h"
+#include "tools/JsonOutput.h"
 
 namespace flipscope::tools {
 namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 struct BenchRenderArgs {
   std::string particles = "4M";

@@ -46,6 +46,7 @@
 #include <glm/trigonometric.hpp>
 #include <nlohmann/json.hpp>
 
+#include "core/Elapsed.h"
 #include "core/Error.h"
 #include "core/Progress.h"
 #include "gl/EglContext.h"
@@ -58,9 +59,9 @@
 #include "smoothing/SurfaceNormals.h"
 #include "smoothing/SurfaceShading.h"
 #include "tools/BenchFoam.h"
-#include "tools/JsonOutput.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
+#include "tools/JsonOutput.h"
 
 namespace flipscope::tools {
 namespace {
@@ -68,8 +69,6 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 using Json = nlohmann::ordered_json;
-
-double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
 constexpr double kCellSize = 0.01;    // world units (not 1, so that a unit slip shows)
 constexpr int kSilhouettePixels = 3;  // measured pixels lie this far from an analytic depth discontinuity

@@ -16,6 +16,7 @@
 #include <glm/gtc/constants.hpp>
 #include <nlohmann/json.hpp>
 
+#include "core/Elapsed.h"
 #include "core/Error.h"
 #include "core/ProcessMemory.h"
 #include "pipeline/FramePipeline.h"
@@ -30,8 +31,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
-
 struct BenchViewArgs {
   std::string particles = "1M";
   int frames = 8;

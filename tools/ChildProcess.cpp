@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cstdio>
 
+#include "core/Elapsed.h"
 #include "core/Error.h"
 
 extern char** environ;
@@ -36,7 +37,7 @@ ChildRun runFlipscopeChild(const std::vector<std::string>& arguments, const std:
   rusage usage{};
   while (::wait4(pid, &status, 0, &usage) < 0 && errno == EINTR) {
   }
-  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  run.seconds = secondsSince(start);
   run.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   run.peakBytes = std::uint64_t(usage.ru_maxrss) * 1024;
   if (std::FILE* out = std::fopen(log.c_str(), "r")) {

@@ -15,6 +15,7 @@
 #endif
 
 #include "core/AtomicFile.h"
+#include "core/Elapsed.h"
 #include "core/Error.h"
 #include "core/ProcessMemory.h"
 #include "preprocess/particles/ParticleSource.h"
@@ -37,8 +38,6 @@ struct EmbreeStageArgs {
 #if FLIPSCOPE_HAVE_EMBREE
 
 using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 /// Embree's own allocations, through its memory monitor.
 struct EmbreeMemory {

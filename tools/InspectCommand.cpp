@@ -15,6 +15,7 @@
 #include <memory>
 
 #include "core/Box.h"
+#include "core/Elapsed.h"
 #include "core/Error.h"
 #include "preprocess/particles/InputSequence.h"
 #include "preprocess/particles/ParticleFormatRegistry.h"
@@ -139,7 +140,7 @@ nlohmann::json inspectFile(const std::filesystem::path& path, bool headerOnly) {
     j["attributes"].push_back(std::move(attribute));
   }
   j["undecodable_attributes"] = undecodable;
-  j["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  j["seconds"] = secondsSince(start);
   return j;
 }
 

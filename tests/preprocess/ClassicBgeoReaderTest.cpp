@@ -22,7 +22,7 @@ namespace fs = std::filesystem;
 using testing::expectFileError;
 using testing::TempDir;
 
-const fs::path kFolder = fs::path(FLIPSCOPE_DATA_DIR) / "formats" / "houdini-classic";
+const fs::path kClassicFolder = fs::path(FLIPSCOPE_DATA_DIR) / "formats" / "houdini-classic";
 
 /// The point count the file's header declares (BgeoV: big-endian int32 at byte 9).
 std::uint64_t declaredPoints(const std::string& bytes) {
@@ -56,9 +56,9 @@ ReadAll readWithAttributes(ParticleSource& source, std::size_t chunkSize) {
 }
 
 TEST(ClassicBgeoReader, RealFilesReadWithTheirDeclaredCounts) {
-  ASSERT_TRUE(fs::is_directory(kFolder)) << kFolder;
+  ASSERT_TRUE(fs::is_directory(kClassicFolder)) << kClassicFolder;
   int files = 0;
-  for (const auto& entry : fs::directory_iterator(kFolder)) {
+  for (const auto& entry : fs::directory_iterator(kClassicFolder)) {
     const fs::path& path = entry.path();
     SCOPED_TRACE(path.filename().string());
     const std::string bytes = testing::readBytes(path);
@@ -84,7 +84,7 @@ TEST(ClassicBgeoReader, RealFileValues) {
     SCOPED_TRACE(name);
     ReadOptions options;
     options.allAttributes = true;
-    auto source = openParticleFile(kFolder / name, options);
+    auto source = openParticleFile(kClassicFolder / name, options);
     const std::vector<AttributeDesc> expected = {{"life", ValueType::Float32, 2}, {"id", ValueType::Int32, 1}};
     EXPECT_EQ(source->attributes(), expected);
     EXPECT_FALSE(source->hasVelocity());
@@ -99,10 +99,10 @@ TEST(ClassicBgeoReader, RealFileValues) {
       EXPECT_EQ(all.attributes.at("id")[p], float(p));
     }
   }
-  if (fs::exists(kFolder / "scatter.bgeo")) {  // Cd (float[3]), id, and an index attribute (not numeric)
+  if (fs::exists(kClassicFolder / "scatter.bgeo")) {  // Cd (float[3]), id, and an index attribute (not numeric)
     ReadOptions options;
     options.attributes = {"Cd", "id"};
-    auto source = openParticleFile(kFolder / "scatter.bgeo", options);
+    auto source = openParticleFile(kClassicFolder / "scatter.bgeo", options);
     const std::vector<AttributeDesc> expected = {{"id", ValueType::Int32, 1}, {"Cd", ValueType::Float32, 3}};
     EXPECT_EQ(source->attributes(), expected);
     const ReadAll all = readWithAttributes(*source, 10);
@@ -112,14 +112,14 @@ TEST(ClassicBgeoReader, RealFileValues) {
     EXPECT_EQ(all.attributes.at("Cd")[2], 0.21119284629821777f);
     EXPECT_EQ(all.attributes.at("id")[24], 24.f);
   }
-  if (fs::exists(kFolder / "reindeer.bgeo")) {  // 491 point attributes, among them v
-    auto source = openParticleFile(kFolder / "reindeer.bgeo");
+  if (fs::exists(kClassicFolder / "reindeer.bgeo")) {  // 491 point attributes, among them v
+    auto source = openParticleFile(kClassicFolder / "reindeer.bgeo");
     EXPECT_TRUE(source->hasVelocity());
     EXPECT_GT(source->attributes().size(), 400u);
     EXPECT_EQ(testing::readAll(*source, 5).size(), 16u);
   }
-  if (fs::exists(kFolder / "json.bgeo")) {  // despite its name a classic BgeoV, with a string (index) attribute
-    auto source = openParticleFile(kFolder / "json.bgeo");
+  if (fs::exists(kClassicFolder / "json.bgeo")) {  // despite its name a classic BgeoV, with a string (index) attribute
+    auto source = openParticleFile(kClassicFolder / "json.bgeo");
     const std::vector<AttributeDesc> expected = {{"life", ValueType::Float32, 2}, {"id", ValueType::Int32, 1}};
     EXPECT_EQ(source->attributes(), expected);
     EXPECT_EQ(testing::readAll(*source, 5).size(), 5u);
@@ -212,8 +212,8 @@ TEST(ClassicBgeoReader, SelectsAttributesAndVelocity) {
 
 TEST(ClassicBgeoReader, RecognisedByContentAndThroughGzip) {
   TempDir dir("bgeo-gzip");
-  const std::string plain = testing::readBytes(kFolder / "test.bgeo");
-  const ParticleChunk expected = testing::readFile(kFolder / "test.bgeo");
+  const std::string plain = testing::readBytes(kClassicFolder / "test.bgeo");
+  const ParticleChunk expected = testing::readFile(kClassicFolder / "test.bgeo");
   for (const char* name : {"test.bgeo.gz", "test.dat", "test.gz"}) {
     const std::string bytes = std::string(name) == "test.dat" ? plain : testing::gzip(plain);
     testing::writeBytes(dir / name, bytes);
@@ -250,8 +250,8 @@ TEST(ClassicBgeoReader, RefusesWhatItCannotRead) {
 
 TEST(ClassicBgeoReader, TruncatedAtEveryLengthIsRefused) {
   testing::BgeoWriteOptions options{true, true};
-  testing::expectEveryTruncationRefused("test.bgeo", testing::readBytes(kFolder / "test.bgeo"));
-  testing::expectEveryTruncationRefused("test.geo", testing::readBytes(kFolder / "test.geo"));
+  testing::expectEveryTruncationRefused("test.bgeo", testing::readBytes(kClassicFolder / "test.bgeo"));
+  testing::expectEveryTruncationRefused("test.geo", testing::readBytes(kClassicFolder / "test.geo"));
   testing::expectEveryTruncationRefused("w.bgeo", testing::makeClassicBgeo(4, kAttributes, position, value, options));
   testing::expectEveryTruncationRefused("w.geo", testing::makeClassicGeo(4, kAttributes, position, value, options));
   // No points: the header and what follows it (detail attributes here) are all there is.
@@ -266,8 +266,8 @@ TEST(ClassicBgeoReader, TruncatedAtEveryLengthIsRefused) {
 
 TEST(ClassicBgeoReader, SingleByteCorruptionsAreReadOrRefused) {
   for (const char* name : {"test.bgeo", "test.geo", "base.bgeo"}) {
-    if (!fs::exists(kFolder / name)) continue;
-    const std::size_t refused = testing::expectCorruptionsHandled(name, testing::readBytes(kFolder / name));
+    if (!fs::exists(kClassicFolder / name)) continue;
+    const std::size_t refused = testing::expectCorruptionsHandled(name, testing::readBytes(kClassicFolder / name));
     EXPECT_GT(refused, 0u) << name;
   }
 }

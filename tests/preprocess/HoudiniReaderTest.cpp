@@ -13,9 +13,10 @@
 #include <map>
 #include <random>
 
-#include "DamageTestSupport.h"
 #include "BgeoTestWriter.h"
+#include "DamageTestSupport.h"
 #include "ParticleTestSupport.h"
+#include "core/Elapsed.h"
 #include "preprocess/particles/ParticleFormatRegistry.h"
 #include "preprocess/particles/ParticleFormats.h"
 
@@ -702,7 +703,7 @@ TEST(HoudiniReader, DISABLED_Throughput) {
       std::uint64_t total = 0;
       while (source->read(chunk, 1 << 20)) total += chunk.size();
       EXPECT_EQ(total, points);
-      best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+      best = std::min(best, secondsSince(start));
     }
     const double megabytes = double(fs::file_size(path)) / 1e6;
     std::printf("%-12s %s: %.3f s, %.1f M points/s, %.0f MB/s of file\n", path.filename().c_str(),

@@ -26,11 +26,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path mantaflow(const char* folder, const char* name) {
-  return fs::path(FLIPSCOPE_DATA_DIR) / "mantaflow-dam64" / folder / name;
-}
-const fs::path kFlip30 = mantaflow("data", "fluid_data_0030.vdb");
-const fs::path kSecondary30 = mantaflow("particles", "fluid_particles_0030.vdb");
+const fs::path kFlip30 = testing::mantaflowFile("data", "fluid_data_0030.vdb");
+const fs::path kSecondary30 = testing::mantaflowFile("particles", "fluid_particles_0030.vdb");
 
 ConvertOptions silent() {
   ConvertOptions options;

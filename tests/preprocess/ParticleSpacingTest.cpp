@@ -11,6 +11,7 @@
 
 #include <glm/common.hpp>
 
+#include "TestSupport.h"
 #include "VectorSource.h"
 #include "preprocess/ParticleSpacing.h"
 
@@ -32,10 +33,6 @@ std::vector<glm::vec3> lattice(int n, float spacing, float jitter, glm::vec3 ori
         points.push_back(origin + spacing * glm::vec3(x + jitter * u(rng), y + jitter * u(rng), z + jitter * u(rng)));
   std::shuffle(points.begin(), points.end(), rng);
   return points;
-}
-
-fs::path mantaflowFrame(const char* folder, const char* name) {
-  return fs::path(FLIPSCOPE_DATA_DIR) / "mantaflow-dam64" / folder / name;
 }
 
 TEST(ParticleSpacing, RegularLatticeGivesItsSpacing) {
@@ -280,7 +277,7 @@ TEST(ParticleSpacing, HintsGiveTheVolumePerParticle) {
 }
 
 TEST(ParticleSpacing, MantaflowVdbMetadataAgreesWithNeighbours) {
-  const fs::path path = mantaflowFrame("data", "fluid_data_0030.vdb");
+  const fs::path path = testing::mantaflowFile("data", "fluid_data_0030.vdb");
   ASSERT_TRUE(fs::exists(path)) << path;
   auto source = openParticleFile(path);
   const auto hint = source->spacingHint();
@@ -301,7 +298,7 @@ TEST(ParticleSpacing, MantaflowVdbMetadataAgreesWithNeighbours) {
   // FLIP and secondary particles read as one frame: the hints add up.
   std::vector<std::unique_ptr<ParticleSource>> parts;
   parts.push_back(openParticleFile(path));
-  parts.push_back(openParticleFile(mantaflowFrame("particles", "fluid_particles_0030.vdb")));
+  parts.push_back(openParticleFile(testing::mantaflowFile("particles", "fluid_particles_0030.vdb")));
   const auto secondary = parts.back()->spacingHint();
   ASSERT_TRUE(secondary);
   auto both = concatSources(std::move(parts));

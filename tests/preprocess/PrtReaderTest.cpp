@@ -22,15 +22,15 @@ using testing::PrtChannelSpec;
 using testing::PrtType;
 using testing::TempDir;
 
-const fs::path kFolder = fs::path(FLIPSCOPE_DATA_DIR) / "formats" / "krakatoa-prt";
+const fs::path kPrtFolder = fs::path(FLIPSCOPE_DATA_DIR) / "formats" / "krakatoa-prt";
 
 TEST(PrtReader, RealFiles) {
-  ASSERT_TRUE(fs::is_directory(kFolder)) << kFolder;
+  ASSERT_TRUE(fs::is_directory(kPrtFolder)) << kPrtFolder;
   // prt_fractal_for_krscene.prt: PRT 1.1 with metadata, 312 particles of Position, Color,
   // Velocity (float32[3]) and Density (float32).
   ReadOptions options;
   options.allAttributes = true;
-  auto source = openParticleFile(kFolder / "prt_fractal_for_krscene.prt", options);
+  auto source = openParticleFile(kPrtFolder / "prt_fractal_for_krscene.prt", options);
   EXPECT_EQ(source->format(), "Krakatoa PRT 1.1 (header version 2)");
   EXPECT_EQ(source->countHint(), 312u);
   EXPECT_TRUE(source->hasVelocity());
@@ -51,7 +51,7 @@ TEST(PrtReader, RealFiles) {
   EXPECT_EQ(density[311], 1.f);
   // negative_eight.prt: a metadata chunk of length -8 (Thinkbox's regression test for an
   // endless loop): refused.
-  expectFileError([&] { testing::readFile(kFolder / "negative_eight.prt"); },
+  expectFileError([&] { testing::readFile(kPrtFolder / "negative_eight.prt"); },
                   {"negative_eight.prt", "chunk 'Metb' at byte 56", "length -8"});
 }
 
@@ -201,7 +201,7 @@ TEST(PrtReader, TruncatedAtEveryLengthIsRefused) {
   const std::vector<PrtChannelSpec> channels = {{"Position", PrtType::Float16, 3}, {"Velocity", PrtType::Float64, 3}};
   auto value = [](std::size_t p, std::size_t i, int c) { return double(p + i) * 0.5 + c; };
   testing::expectEveryTruncationRefused("small.prt", testing::makePrt(channels, 40, value, {.piece = 64}));
-  testing::expectEveryTruncationRefused("fractal.prt", testing::readBytes(kFolder / "prt_fractal_for_krscene.prt"));
+  testing::expectEveryTruncationRefused("fractal.prt", testing::readBytes(kPrtFolder / "prt_fractal_for_krscene.prt"));
 }
 
 TEST(PrtReader, SingleByteCorruptionsAreReadOrRefused) {

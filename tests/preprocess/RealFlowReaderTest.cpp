@@ -20,7 +20,7 @@ namespace fs = std::filesystem;
 using testing::expectFileError;
 using testing::TempDir;
 
-const fs::path kFolder = fs::path(FLIPSCOPE_DATA_DIR) / "formats" / "realflow-bin";
+const fs::path kRealFlowFolder = fs::path(FLIPSCOPE_DATA_DIR) / "formats" / "realflow-bin";
 
 struct Columns {
   ParticleChunk particles;
@@ -50,9 +50,9 @@ std::size_t attributeIndex(const ParticleSource& source, const std::string& name
 }
 
 TEST(RealFlowReader, RealSequence) {
-  ASSERT_TRUE(fs::is_directory(kFolder)) << kFolder;
+  ASSERT_TRUE(fs::is_directory(kRealFlowFolder)) << kRealFlowFolder;
   int files = 0;
-  for (const auto& entry : fs::directory_iterator(kFolder)) {
+  for (const auto& entry : fs::directory_iterator(kRealFlowFolder)) {
     SCOPED_TRACE(entry.path().filename().string());
     const std::string bytes = testing::readBytes(entry.path());
     std::int32_t declared;
@@ -69,10 +69,10 @@ TEST(RealFlowReader, RealSequence) {
   }
   EXPECT_GE(files, 2);
   // Frame 0 is empty (the emitter starts), frame 1 holds 62 particles, frame 5 155.
-  EXPECT_EQ(testing::readFile(kFolder / "Circle01_00000.bin").size(), 0u);
+  EXPECT_EQ(testing::readFile(kRealFlowFolder / "Circle01_00000.bin").size(), 0u);
   ReadOptions options;
   options.allAttributes = true;
-  auto source = openParticleFile(kFolder / "Circle01_00001.bin", options);
+  auto source = openParticleFile(kRealFlowFolder / "Circle01_00001.bin", options);
   const Columns one = readColumns(*source, 10);
   ASSERT_EQ(one.particles.size(), 62u);
   EXPECT_EQ(one.particles.positions[0], glm::vec3(-0.0296834391f, 0.966666639f, 0.385534704f));
@@ -83,8 +83,8 @@ TEST(RealFlowReader, RealSequence) {
   EXPECT_EQ(one.attributes[attributeIndex(*source, "temperature")][61], 300.f);
   EXPECT_EQ(one.attributes[attributeIndex(*source, "id")][0], 62.f);
   EXPECT_EQ(one.attributes[attributeIndex(*source, "id")][61], 1.f);
-  if (fs::exists(kFolder / "Circle01_00005.bin")) {
-    auto five = openParticleFile(kFolder / "Circle01_00005.bin", options);
+  if (fs::exists(kRealFlowFolder / "Circle01_00005.bin")) {
+    auto five = openParticleFile(kRealFlowFolder / "Circle01_00005.bin", options);
     const Columns all = readColumns(*five, 1000);
     ASSERT_EQ(all.particles.size(), 155u);
     EXPECT_EQ(all.particles.positions[154], glm::vec3(-5.53168757e-05f, 0.83448267f, -2.78298066e-05f));
@@ -96,7 +96,7 @@ TEST(RealFlowReader, NeverReadAsRawFloats) {
   TempDir dir("realflow-raw");
   // Every real frame, and a frame whose size is a multiple of 12 (which the raw reader would
   // accept): recognised by the magic number, whatever the name.
-  for (const auto& entry : fs::directory_iterator(kFolder)) {
+  for (const auto& entry : fs::directory_iterator(kRealFlowFolder)) {
     const RecognisedInput input = recogniseInput(InputFile(entry.path()));
     EXPECT_EQ(input.format->name, "realflow-bin") << entry.path();
   }
@@ -176,13 +176,16 @@ TEST(RealFlowReader, TrailingSectionsOfDifferentWriters) {
 
 TEST(RealFlowReader, TruncatedAtEveryLengthIsRefused) {
   // From 1 byte on: an empty file named .bin is an empty raw float file (no magic to tell).
-  testing::expectEveryTruncationRefused("Circle01_00000.bin", testing::readBytes(kFolder / "Circle01_00000.bin"), 1);
-  testing::expectEveryTruncationRefused("Circle01_00001.bin", testing::readBytes(kFolder / "Circle01_00001.bin"), 1);
+  testing::expectEveryTruncationRefused("Circle01_00000.bin",
+                                        testing::readBytes(kRealFlowFolder / "Circle01_00000.bin"), 1);
+  testing::expectEveryTruncationRefused("Circle01_00001.bin",
+                                        testing::readBytes(kRealFlowFolder / "Circle01_00001.bin"), 1);
   testing::expectEveryTruncationRefused("v12.bin", testing::makeRealFlowBin(12, 3), 1);
 }
 
 TEST(RealFlowReader, SingleByteCorruptionsAreReadOrRefused) {
-  EXPECT_GT(testing::expectCorruptionsHandled("Circle01_00000.bin", testing::readBytes(kFolder / "Circle01_00000.bin")),
+  EXPECT_GT(testing::expectCorruptionsHandled("Circle01_00000.bin",
+                                              testing::readBytes(kRealFlowFolder / "Circle01_00000.bin")),
             0u);
   EXPECT_GT(testing::expectCorruptionsHandled("v11.bin", testing::makeRealFlowBin(11, 2)), 0u);
 }

@@ -57,10 +57,6 @@ std::string synthVdb(std::uint64_t particles, bool velocity) {
   return testing::readBytes(dir / "s.vdb");
 }
 
-fs::path mantaflowFile(const char* folder, const char* name) {
-  return fs::path(FLIPSCOPE_DATA_DIR) / "mantaflow-dam64" / folder / name;
-}
-
 struct Sweep {
   std::size_t mutations = 0, refused = 0;
 };
@@ -100,9 +96,9 @@ TEST(VdbDamage, EverySingleByteChangeOfASynthVdb) {
 
 TEST(VdbDamage, EveryTruncationIsRefused) {
   truncateEverywhere("s.vdb", synthVdb(1000, true), 1);
-  truncateEverywhere("p.vdb", testing::readBytes(mantaflowFile("particles", "fluid_particles_0002.vdb")), 1);
-  truncateEverywhere("e.vdb", testing::readBytes(mantaflowFile("particles", "fluid_particles_0001.vdb")), 1);
-  truncateEverywhere("d.vdb", testing::readBytes(mantaflowFile("data", "fluid_data_0030.vdb")), 97);
+  truncateEverywhere("p.vdb", testing::readBytes(testing::mantaflowFile("particles", "fluid_particles_0002.vdb")), 1);
+  truncateEverywhere("e.vdb", testing::readBytes(testing::mantaflowFile("particles", "fluid_particles_0001.vdb")), 1);
+  truncateEverywhere("d.vdb", testing::readBytes(testing::mantaflowFile("data", "fluid_data_0030.vdb")), 97);
 }
 
 TEST(VdbDamage, MantaflowFiles) {
@@ -114,7 +110,7 @@ TEST(VdbDamage, MantaflowFiles) {
   for (const File& f :
        {File{"particles", "fluid_particles_0001.vdb", 1}, File{"particles", "fluid_particles_0002.vdb", 1},
         File{"data", "fluid_data_0002.vdb", 13}, File{"data", "fluid_data_0030.vdb", 151}}) {
-    const std::string original = testing::readBytes(mantaflowFile(f.folder, f.name));
+    const std::string original = testing::readBytes(testing::mantaflowFile(f.folder, f.name));
     ASSERT_FALSE(original.empty()) << f.name;
     const Sweep sweep = mutateBytes(f.name, original, f.step);
     std::printf("%s (%zu bytes, every %zu. byte): %zu changes, %zu refused, none crashed\n", f.name, original.size(),
@@ -144,7 +140,7 @@ TEST(VdbDamage, CommandLineExitsWith3AndNamesTheFile) {
   TempDir dir("vdb-damage-cli");
   ASSERT_EQ(testing::runFlipscope("synth -o s.vdb --particles 1k", dir.path()).exitCode, 0);
   const std::string synth = testing::readBytes(dir / "s.vdb");
-  const std::string mantaflow = testing::readBytes(mantaflowFile("particles", "fluid_particles_0002.vdb"));
+  const std::string mantaflow = testing::readBytes(testing::mantaflowFile("particles", "fluid_particles_0002.vdb"));
   struct Case {
     std::string name, bytes;
     bool mayRead;  ///< a change inside a position still makes a readable file

@@ -40,7 +40,7 @@ TEST(ClearDistance, IsTheChebyshevDistanceToTheNearestSetBlock) {
   std::mt19937 random(7);
   for (const glm::ivec3 n : shapes)
     for (const double density : densities) {
-      SCOPED_TRACE(testing::Message() << n.x << "x" << n.y << "x" << n.z << " density " << density);
+      SCOPED_TRACE(::testing::Message() << n.x << "x" << n.y << "x" << n.z << " density " << density);
       const std::size_t count = std::size_t(n.x) * n.y * n.z;
       std::vector<bool> set(count);
       std::vector<std::uint32_t> words((count + 31) / 32, 0);
@@ -71,7 +71,7 @@ TEST(ClearDistance, SetBlockBoundsHoldEverySetBlockAndNoMore) {
   std::mt19937 random(11);
   for (const glm::ivec3 n : {glm::ivec3(17, 17, 9), glm::ivec3(16, 16, 16), glm::ivec3(1, 1, 1)})
     for (int blocks : {0, 1, 3, 40}) {
-      SCOPED_TRACE(testing::Message() << n.x << "x" << n.y << "x" << n.z << ", " << blocks << " set");
+      SCOPED_TRACE(::testing::Message() << n.x << "x" << n.y << "x" << n.z << ", " << blocks << " set");
       const std::size_t count = std::size_t(n.x) * n.y * n.z;
       std::vector<std::uint32_t> words((count + 31) / 32, 0);
       glm::ivec3 lo(1 << 20), hi(-1);

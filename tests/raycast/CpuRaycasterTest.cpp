@@ -31,12 +31,8 @@ std::string firstDifference(const std::vector<RayHit>& a, const std::vector<RayH
   return "identical";
 }
 
+using testing::cpuRenderer;
 using testing::TempDir;
-
-std::unique_ptr<FrameRenderer> cpuRenderer(const BrickStore& store, const RenderSettings& settings) {
-  return std::make_unique<FrameRenderer>(std::make_shared<StoreBrickSource>(store), std::make_unique<CpuRaycaster>(),
-                                         settings);
-}
 
 TEST(CpuRaycaster, BallRendersAsDiskWithAnalyticDepth) {
   TempDir dir("ball");

@@ -12,6 +12,7 @@
 namespace flipscope {
 namespace {
 
+using testing::cpuRenderer;
 using testing::FoamBrickShape;
 using testing::TempDir;
 
@@ -124,11 +125,6 @@ TEST(FoamClassification, KeepsTheUploadedKindBitsAndAddsTheClassifiedCells) {
   auto expected = testing::bruteForceFoam(brick, shape, 0.2f);
   expected[subBrick][int(bit >> 5)] |= 1u << (bit & 31);
   EXPECT_EQ(device.readFoam(0), expected);
-}
-
-std::unique_ptr<FrameRenderer> cpuRenderer(const BrickStore& store, const RenderSettings& settings) {
-  return std::make_unique<FrameRenderer>(std::make_shared<StoreBrickSource>(store), std::make_unique<CpuRaycaster>(),
-                                         settings);
 }
 
 Camera lookingDown(glm::dvec3 target, double height) {

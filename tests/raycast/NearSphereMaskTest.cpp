@@ -19,7 +19,7 @@ struct Case {
 TEST(NearSphereMask, MatchesTheCellsWithASphereWithinReach) {
   for (const Case c : {Case{32, 1, 1, false}, Case{64, 2, 2, true}, Case{64, 3, 1, false}, Case{128, 2, 0, false},
                        Case{32, 8, 8, true}, Case{128, 3, 3, true}}) {
-    SCOPED_TRACE(testing::Message() << c.brickSize << " overlap " << c.overlap << " reach " << c.reach);
+    SCOPED_TRACE(::testing::Message() << c.brickSize << " overlap " << c.overlap << " reach " << c.reach);
     const glm::uvec3 dims = bitBrickSubBrickDims(c.brickSize, c.overlap);
     const std::size_t subBricks = std::size_t(dims.x) * dims.y * dims.z;
     std::vector<glm::uvec4> bits(subBricks, glm::uvec4(0)), foam(subBricks, glm::uvec4(0));

@@ -4,12 +4,15 @@
 #pragma once
 
 #include <cmath>
+#include <memory>
 #include <random>
 
 #include "preprocess/Convert.h"
 #include "preprocess/VectorSource.h"
 #include "raycast/Camera.h"
+#include "raycast/CpuRaycaster.h"
 #include "raycast/FrameRenderer.h"
+#include "streaming/BrickSource.h"
 
 namespace flipscope::testing {
 
@@ -29,6 +32,12 @@ inline BrickStore makeStore(const std::filesystem::path& dir, const std::vector<
     convertFrame(source, store, int(f), options);
   }
   return BrickStore::open(dir);
+}
+
+/// A FrameRenderer of `store` on the CPU reference ray-caster.
+inline std::unique_ptr<FrameRenderer> cpuRenderer(const BrickStore& store, const RenderSettings& settings) {
+  return std::make_unique<FrameRenderer>(std::make_shared<StoreBrickSource>(store), std::make_unique<CpuRaycaster>(),
+                                         settings);
 }
 
 /// One particle at every cell centre within `radius` of `centre` (cell units = world units).

@@ -19,8 +19,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using flipscope::testing::CommandRun;
-CommandRun run(const std::string& args) { return flipscope::testing::runFlipscope(args); }
-
+using flipscope::testing::runFlipscope;
 /// temperature of the particle at x: 10 x - 3 (x in 0.025 .. 0.975).
 float temperatureAt(float x) { return 10.0f * x - 3.0f; }
 
@@ -51,11 +50,12 @@ class AttributeCli : public ::testing::Test {
 };
 
 TEST_F(AttributeCli, ConvertStoresTheNamedAttributeAndInfoShowsItsNameAndRange) {
-  CommandRun convert = run("convert " + path("slab.ply") + " -o " + path("store") + " --attribute temperature");
+  CommandRun convert =
+      runFlipscope("convert " + path("slab.ply") + " -o " + path("store") + " --attribute temperature");
   ASSERT_EQ(convert.exitCode, 0) << convert.output;
   EXPECT_NE(convert.output.find("attribute temperature (scalar)"), std::string::npos) << convert.output;
 
-  CommandRun info = run("info --json " + path("store"));
+  CommandRun info = runFlipscope("info --json " + path("store"));
   ASSERT_EQ(info.exitCode, 0) << info.output;
   const auto j = nlohmann::json::parse(info.output);
   EXPECT_EQ(j["attribute"], "temperature");
@@ -67,31 +67,33 @@ TEST_F(AttributeCli, ConvertStoresTheNamedAttributeAndInfoShowsItsNameAndRange) 
   EXPECT_EQ(j["attribute_range"][1].get<float>(), hi);
   EXPECT_EQ(j["frames"][0]["attribute_range"][0].get<float>(), lo);
 
-  CommandRun text = run("info " + path("store"));
+  CommandRun text = runFlipscope("info " + path("store"));
   ASSERT_EQ(text.exitCode, 0) << text.output;
   EXPECT_NE(text.output.find("attribute  temperature (scalar), -2.875 to 6.875 over the frames"), std::string::npos)
       << text.output;
 
   // No velocities: auto stores none.
-  ASSERT_EQ(run("convert " + path("slab.ply") + " -o " + path("plain") + " -q").exitCode, 0);
-  EXPECT_EQ(nlohmann::json::parse(run("info --json " + path("plain")).output)["attribute"], "none");
+  ASSERT_EQ(runFlipscope("convert " + path("slab.ply") + " -o " + path("plain") + " -q").exitCode, 0);
+  EXPECT_EQ(nlohmann::json::parse(runFlipscope("info --json " + path("plain")).output)["attribute"], "none");
 }
 
 TEST_F(AttributeCli, ANameTheInputLacksExitsWith3NamingTheFileAndItsAttributes) {
-  CommandRun convert = run("convert " + path("slab.ply") + " -o " + path("store") + " --attribute pscale");
+  CommandRun convert = runFlipscope("convert " + path("slab.ply") + " -o " + path("store") + " --attribute pscale");
   EXPECT_EQ(convert.exitCode, 3) << convert.output;
   EXPECT_NE(convert.output.find("slab.ply: has no attribute 'pscale' (it holds: temperature, id)"), std::string::npos)
       << convert.output;
   EXPECT_FALSE(fs::exists(path("store")));
-  CommandRun speed = run("convert " + path("slab.ply") + " -o " + path("store") + " --attribute speed");
+  CommandRun speed = runFlipscope("convert " + path("slab.ply") + " -o " + path("store") + " --attribute speed");
   EXPECT_EQ(speed.exitCode, 3) << speed.output;
   EXPECT_NE(speed.output.find("no attribute 'speed'"), std::string::npos) << speed.output;
 }
 
 TEST_F(AttributeCli, RenderColoursByTheAttributeAndTheExrCarriesIt) {
-  ASSERT_EQ(run("convert " + path("slab.ply") + " -o " + path("store") + " --attribute temperature -q").exitCode, 0);
+  ASSERT_EQ(
+      runFlipscope("convert " + path("slab.ply") + " -o " + path("store") + " --attribute temperature -q").exitCode, 0);
   const auto render = [&](const std::string& name, const std::string& options) {
-    CommandRun r = run("render " + path("store") + " -o " + path(name) + " --size 96x54 --device cpu " + options);
+    CommandRun r =
+        runFlipscope("render " + path("store") + " -o " + path(name) + " --size 96x54 --device cpu " + options);
     EXPECT_EQ(r.exitCode, 0) << options << "\n" << r.output;
     return flipscope::readExr(path(name));
   };
@@ -132,10 +134,11 @@ TEST_F(AttributeCli, RenderColoursByTheAttributeAndTheExrCarriesIt) {
 }
 
 TEST_F(AttributeCli, BadColourOptionsExitWith2ListingTheValidValues) {
-  ASSERT_EQ(run("convert " + path("slab.ply") + " -o " + path("store") + " --attribute temperature -q").exitCode, 0);
-  ASSERT_EQ(run("convert " + path("slab.ply") + " -o " + path("plain") + " --attribute none -q").exitCode, 0);
+  ASSERT_EQ(
+      runFlipscope("convert " + path("slab.ply") + " -o " + path("store") + " --attribute temperature -q").exitCode, 0);
+  ASSERT_EQ(runFlipscope("convert " + path("slab.ply") + " -o " + path("plain") + " --attribute none -q").exitCode, 0);
   const auto expectError = [&](const std::string& store, const std::string& options, const std::string& needle) {
-    CommandRun r = run("render " + path(store) + " -o " + path("x.png") + " --size 32x18 " + options);
+    CommandRun r = runFlipscope("render " + path(store) + " -o " + path("x.png") + " --size 32x18 " + options);
     EXPECT_EQ(r.exitCode, 2) << options << "\n" << r.output;
     EXPECT_NE(r.output.find(needle), std::string::npos) << options << "\n" << r.output;
   };
@@ -151,7 +154,8 @@ TEST_F(AttributeCli, BadColourOptionsExitWith2ListingTheValidValues) {
   expectError("plain", "--color-map magma", "no per-particle attribute");
   EXPECT_FALSE(fs::exists(path("x.png")));
   // --shading attribute on a store without one stays the plain lit surface.
-  CommandRun lit = run("render " + path("plain") + " -o " + path("lit.png") + " --size 32x18 --shading attribute");
+  CommandRun lit =
+      runFlipscope("render " + path("plain") + " -o " + path("lit.png") + " --size 32x18 --shading attribute");
   EXPECT_EQ(lit.exitCode, 0) << lit.output;
 }
 

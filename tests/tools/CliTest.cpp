@@ -13,8 +13,7 @@ namespace {
 namespace fs = std::filesystem;
 
 using flipscope::testing::CommandRun;
-CommandRun run(const std::string& args) { return flipscope::testing::runFlipscope(args); }
-
+using flipscope::testing::runFlipscope;
 /// A frame file's bytes but for the store id (random per store) and the index checksum over it:
 /// the footer's bytes 40 to 24 and 16 to 8 from the end of the file, zeroed. `id`: what was there.
 std::string frameBytesWithoutStoreId(const fs::path& frameFile, std::string* id = nullptr) {
@@ -35,13 +34,14 @@ class Cli : public ::testing::Test {
 };
 
 TEST_F(Cli, SynthConvertInfoRoundTrip) {
-  CommandRun synth = run("synth -o " + path("fluid_####.ply") + " --particles 20k --frames 1-2 --velocity");
+  CommandRun synth = runFlipscope("synth -o " + path("fluid_####.ply") + " --particles 20k --frames 1-2 --velocity");
   ASSERT_EQ(synth.exitCode, 0) << synth.output;
-  CommandRun convert = run("convert " + path("fluid_####.ply") + " -o " + path("store") + " --resolution 128 --brick-size 32");
+  CommandRun convert =
+      runFlipscope("convert " + path("fluid_####.ply") + " -o " + path("store") + " --resolution 128 --brick-size 32");
   ASSERT_EQ(convert.exitCode, 0) << convert.output;
   EXPECT_NE(convert.output.find("frame 2"), std::string::npos) << convert.output;
 
-  CommandRun info = run("info --json --verify " + path("store"));
+  CommandRun info = runFlipscope("info --json --verify " + path("store"));
   ASSERT_EQ(info.exitCode, 0) << info.output;
   auto j = nlohmann::json::parse(info.output);
   ASSERT_EQ(j["frames"].size(), 2u);
@@ -54,10 +54,10 @@ TEST_F(Cli, SynthConvertInfoRoundTrip) {
   EXPECT_TRUE(j["verified"].get<bool>());
 
   // Appending a third frame keeps the store's domain.
-  ASSERT_EQ(run("synth -o " + path("extra.ply") + " --particles 20k --frames 3 --velocity").exitCode, 0);
-  CommandRun append = run("convert " + path("extra.ply") + " -o " + path("store"));
+  ASSERT_EQ(runFlipscope("synth -o " + path("extra.ply") + " --particles 20k --frames 3 --velocity").exitCode, 0);
+  CommandRun append = runFlipscope("convert " + path("extra.ply") + " -o " + path("store"));
   EXPECT_EQ(append.exitCode, 0) << append.output;
-  CommandRun after = run("info --json " + path("store"));
+  CommandRun after = runFlipscope("info --json " + path("store"));
   ASSERT_EQ(after.exitCode, 0) << after.output;
   const auto k = nlohmann::json::parse(after.output);
   EXPECT_EQ(k["frames"].size(), 3u);
@@ -67,14 +67,14 @@ TEST_F(Cli, SynthConvertInfoRoundTrip) {
 TEST_F(Cli, DefaultConvertOfMantaflowMakesOneCellPerParticleSpacingAndInfoShowsIt) {
   const fs::path vdb = fs::path(FLIPSCOPE_DATA_DIR) / "mantaflow-dam64" / "data" / "fluid_data_0030.vdb";
   ASSERT_TRUE(fs::exists(vdb)) << vdb;
-  CommandRun convert = run("convert '" + vdb.string() + "' -o " + path("store"));
+  CommandRun convert = runFlipscope("convert '" + vdb.string() + "' -o " + path("store"));
   ASSERT_EQ(convert.exitCode, 0) << convert.output;
   EXPECT_NE(convert.output.find("(one cell per particle spacing)"), std::string::npos) << convert.output;
   EXPECT_NE(convert.output.find("(1.00 cells), from frame 0: OpenVDB grid 'particles'"), std::string::npos)
       << convert.output;
   EXPECT_EQ(convert.output.find("warning"), std::string::npos) << convert.output;
 
-  CommandRun info = run("info --json " + path("store"));
+  CommandRun info = runFlipscope("info --json " + path("store"));
   ASSERT_EQ(info.exitCode, 0) << info.output;
   auto j = nlohmann::json::parse(info.output);
   ASSERT_TRUE(j["particle_spacing"].is_number()) << info.output;
@@ -86,14 +86,14 @@ TEST_F(Cli, DefaultConvertOfMantaflowMakesOneCellPerParticleSpacingAndInfoShowsI
   EXPECT_EQ(j["version"].get<std::uint32_t>(), 6u);
   EXPECT_EQ(j["particle_kinds"], false) << "a FLIP file alone";
 
-  CommandRun text = run("info " + path("store"));
+  CommandRun text = runFlipscope("info " + path("store"));
   ASSERT_EQ(text.exitCode, 0) << text.output;
   EXPECT_NE(text.output.find("particle spacing"), std::string::npos) << text.output;
   EXPECT_NE(text.output.find("= 1.00 cells of"), std::string::npos) << text.output;
 
   // With --cell-size the spacing is still measured and recorded.
-  ASSERT_EQ(run("convert '" + vdb.string() + "' -o " + path("coarse") + " --cell-size 0.1 -q").exitCode, 0);
-  auto coarse = nlohmann::json::parse(run("info --json " + path("coarse")).output);
+  ASSERT_EQ(runFlipscope("convert '" + vdb.string() + "' -o " + path("coarse") + " --cell-size 0.1 -q").exitCode, 0);
+  auto coarse = nlohmann::json::parse(runFlipscope("info --json " + path("coarse")).output);
   EXPECT_EQ(coarse["cell_size"].get<double>(), 0.1);
   EXPECT_EQ(coarse["particle_spacing"].get<double>(), spacing);
   EXPECT_NEAR(coarse["particle_spacing_cells"].get<double>(), spacing / 0.1, 1e-12);
@@ -101,18 +101,18 @@ TEST_F(Cli, DefaultConvertOfMantaflowMakesOneCellPerParticleSpacingAndInfoShowsI
 
 TEST_F(Cli, TheStoresUpAxisOrientsRenderUnlessGivenUp) {
   const fs::path vdb = fs::path(FLIPSCOPE_DATA_DIR) / "mantaflow-dam64" / "data" / "fluid_data_0030.vdb";
-  CommandRun inspect = run("inspect '" + vdb.string() + "'");
+  CommandRun inspect = runFlipscope("inspect '" + vdb.string() + "'");
   ASSERT_EQ(inspect.exitCode, 0) << inspect.output;
   EXPECT_NE(inspect.output.find("up axis     z (the file's conventions"), std::string::npos) << inspect.output;
-  CommandRun convert = run("convert '" + vdb.string() + "' -o " + path("store"));
+  CommandRun convert = runFlipscope("convert '" + vdb.string() + "' -o " + path("store"));
   ASSERT_EQ(convert.exitCode, 0) << convert.output;
   EXPECT_NE(convert.output.find("up axis z (the conventions of"), std::string::npos) << convert.output;
-  EXPECT_EQ(nlohmann::json::parse(run("info --json " + path("store")).output)["up_axis"], "z");
-  EXPECT_NE(run("info " + path("store")).output.find("up axis    z"), std::string::npos);
+  EXPECT_EQ(nlohmann::json::parse(runFlipscope("info --json " + path("store")).output)["up_axis"], "z");
+  EXPECT_NE(runFlipscope("info " + path("store")).output.find("up axis    z"), std::string::npos);
 
   const auto cameraUp = [&](const std::string& options) {
-    CommandRun render = run("render " + path("store") + " -o " + path("a.png") + " --size 64x36 -q --save-camera " +
-                            path("cam.json") + " " + options);
+    CommandRun render = runFlipscope("render " + path("store") + " -o " + path("a.png") +
+                                     " --size 64x36 -q --save-camera " + path("cam.json") + " " + options);
     EXPECT_EQ(render.exitCode, 0) << render.output;
     std::ifstream in(path("cam.json"));
     return nlohmann::json::parse(in)["up"];
@@ -121,23 +121,24 @@ TEST_F(Cli, TheStoresUpAxisOrientsRenderUnlessGivenUp) {
   EXPECT_EQ(cameraUp("--up auto"), nlohmann::json::array({0.0, 0.0, 1.0}));
   EXPECT_EQ(cameraUp("--up y"), nlohmann::json::array({0.0, 1.0, 0.0})) << "--up wins";
 
-  CommandRun bad = run("convert '" + vdb.string() + "' -o " + path("other") + " --up w");
+  CommandRun bad = runFlipscope("convert '" + vdb.string() + "' -o " + path("other") + " --up w");
   EXPECT_EQ(bad.exitCode, 2) << bad.output;
   EXPECT_NE(bad.output.find("--up: expected auto, x, y or z, got 'w'"), std::string::npos) << bad.output;
   // A store of files that say nothing records nothing, and renders take y.
-  ASSERT_EQ(run("synth -o " + path("s.ply") + " --particles 2k").exitCode, 0);
-  ASSERT_EQ(run("convert " + path("s.ply") + " -o " + path("plain") + " -q").exitCode, 0);
-  EXPECT_TRUE(nlohmann::json::parse(run("info --json " + path("plain")).output)["up_axis"].is_null());
-  CommandRun plain = run("render " + path("plain") + " -o " + path("p.png") + " --size 64x36 -q --save-camera " +
-                         path("cam.json"));
+  ASSERT_EQ(runFlipscope("synth -o " + path("s.ply") + " --particles 2k").exitCode, 0);
+  ASSERT_EQ(runFlipscope("convert " + path("s.ply") + " -o " + path("plain") + " -q").exitCode, 0);
+  EXPECT_TRUE(nlohmann::json::parse(runFlipscope("info --json " + path("plain")).output)["up_axis"].is_null());
+  CommandRun plain = runFlipscope("render " + path("plain") + " -o " + path("p.png") +
+                                  " --size 64x36 -q --save-camera " + path("cam.json"));
   ASSERT_EQ(plain.exitCode, 0) << plain.output;
   std::ifstream in(path("cam.json"));
   EXPECT_EQ(nlohmann::json::parse(in)["up"], nlohmann::json::array({0.0, 1.0, 0.0}));
 }
 
 TEST_F(Cli, DamagedStoreFailsVerifyNamingFileAndBrick) {
-  ASSERT_EQ(run("synth -o " + path("f.bin") + " --particles 5k").exitCode, 0);
-  ASSERT_EQ(run("convert " + path("f.bin") + " -o " + path("store") + " --resolution 64 --brick-size 32 -q").exitCode,
+  ASSERT_EQ(runFlipscope("synth -o " + path("f.bin") + " --particles 5k").exitCode, 0);
+  ASSERT_EQ(runFlipscope("convert " + path("f.bin") + " -o " + path("store") + " --resolution 64 --brick-size 32 -q")
+                .exitCode,
             0);
   const fs::path frame = dir / "store" / "frame_000000.fsf";
   ASSERT_TRUE(fs::exists(frame));
@@ -146,44 +147,44 @@ TEST_F(Cli, DamagedStoreFailsVerifyNamingFileAndBrick) {
     f.seekp(20);
     f.put('\x7f');
   }
-  EXPECT_EQ(run("info " + path("store")).exitCode, 0);  // the index is intact
-  CommandRun verify = run("info --verify " + path("store"));
+  EXPECT_EQ(runFlipscope("info " + path("store")).exitCode, 0);  // the index is intact
+  CommandRun verify = runFlipscope("info --verify " + path("store"));
   EXPECT_EQ(verify.exitCode, 1) << verify.output;
   EXPECT_NE(verify.output.find("frame_000000.fsf: brick 0"), std::string::npos) << verify.output;
 
   // A truncated frame file is refused by plain info, with exit code 3 (bad input).
   fs::resize_file(frame, fs::file_size(frame) - 5);
-  CommandRun info = run("info " + path("store"));
+  CommandRun info = runFlipscope("info " + path("store"));
   EXPECT_EQ(info.exitCode, 3) << info.output;
   EXPECT_NE(info.output.find("frame_000000.fsf"), std::string::npos) << info.output;
 }
 
 TEST_F(Cli, BadInputsGiveClearErrorsAndExitCodes) {
   std::ofstream(path("odd.bin"), std::ios::binary) << "12345678901234";  // 14 bytes: not a multiple of 12
-  CommandRun odd = run("convert " + path("odd.bin") + " -o " + path("s1"));
+  CommandRun odd = runFlipscope("convert " + path("odd.bin") + " -o " + path("s1"));
   EXPECT_EQ(odd.exitCode, 3) << odd.output;
   EXPECT_NE(odd.output.find("odd.bin"), std::string::npos) << odd.output;
   EXPECT_FALSE(fs::exists(dir / "s1" / "frame_000000.fsf"));
 
-  CommandRun missing = run("convert " + path("nothing.ply") + " -o " + path("s2"));
+  CommandRun missing = runFlipscope("convert " + path("nothing.ply") + " -o " + path("s2"));
   EXPECT_EQ(missing.exitCode, 3) << missing.output;
   EXPECT_NE(missing.output.find("nothing.ply"), std::string::npos) << missing.output;
 
-  CommandRun badMem = run("convert " + path("odd.bin") + " -o " + path("s3") + " --mem lots");
+  CommandRun badMem = runFlipscope("convert " + path("odd.bin") + " -o " + path("s3") + " --mem lots");
   EXPECT_EQ(badMem.exitCode, 2) << badMem.output;
   EXPECT_NE(badMem.output.find("--mem"), std::string::npos) << badMem.output;
 
-  CommandRun notStore = run("info " + path(""));
+  CommandRun notStore = runFlipscope("info " + path(""));
   EXPECT_EQ(notStore.exitCode, 3) << notStore.output;
   EXPECT_NE(notStore.output.find("store.fsh missing"), std::string::npos) << notStore.output;
 
-  EXPECT_EQ(run("frobnicate").exitCode, 2);
+  EXPECT_EQ(runFlipscope("frobnicate").exitCode, 2);
 }
 
 TEST_F(Cli, OutOfCoreConvertMatchesInCore) {
-  ASSERT_EQ(run("synth -o " + path("big.bin") + " --particles 600k").exitCode, 0);
-  ASSERT_EQ(run("convert " + path("big.bin") + " -o " + path("a") + " --resolution 256 -q").exitCode, 0);
-  CommandRun out = run("convert " + path("big.bin") + " -o " + path("b") + " --resolution 256 --mem 2M");
+  ASSERT_EQ(runFlipscope("synth -o " + path("big.bin") + " --particles 600k").exitCode, 0);
+  ASSERT_EQ(runFlipscope("convert " + path("big.bin") + " -o " + path("a") + " --resolution 256 -q").exitCode, 0);
+  CommandRun out = runFlipscope("convert " + path("big.bin") + " -o " + path("b") + " --resolution 256 --mem 2M");
   ASSERT_EQ(out.exitCode, 0) << out.output;
   EXPECT_NE(out.output.find("out of core"), std::string::npos) << out.output;
   std::string idA, idB;
@@ -198,16 +199,16 @@ TEST_F(Cli, OutOfCoreConvertMatchesInCore) {
 // store; a value of FLIPSCOPE_HUGE_PAGES that is none of on, off, auto is a usage error of the
 // commands that choose (not of --help, nor of info).
 TEST_F(Cli, HugePageAdviceOnOrOffWritesTheSameStore) {
-  ASSERT_EQ(run("synth -o " + path("f.bin") + " --particles 600k").exitCode, 0);
+  ASSERT_EQ(runFlipscope("synth -o " + path("f.bin") + " --particles 600k").exitCode, 0);
   ::setenv("FLIPSCOPE_HUGE_PAGES", "on", 1);
-  const CommandRun on = run("convert " + path("f.bin") + " -o " + path("on") + " --resolution 256 -q");
+  const CommandRun on = runFlipscope("convert " + path("f.bin") + " -o " + path("on") + " --resolution 256 -q");
   ::setenv("FLIPSCOPE_HUGE_PAGES", "off", 1);
-  const CommandRun off = run("convert " + path("f.bin") + " -o " + path("off") + " --resolution 256 -q");
+  const CommandRun off = runFlipscope("convert " + path("f.bin") + " -o " + path("off") + " --resolution 256 -q");
   ::setenv("FLIPSCOPE_HUGE_PAGES", "maybe", 1);
-  const CommandRun bad = run("convert " + path("f.bin") + " -o " + path("bad") + " --resolution 256 -q");
+  const CommandRun bad = runFlipscope("convert " + path("f.bin") + " -o " + path("bad") + " --resolution 256 -q");
   // Commands that allocate little never choose, so never read the variable.
-  const CommandRun help = run("convert --help");
-  const CommandRun info = run("info " + path("on"));
+  const CommandRun help = runFlipscope("convert --help");
+  const CommandRun info = runFlipscope("info " + path("on"));
   ::unsetenv("FLIPSCOPE_HUGE_PAGES");
   EXPECT_EQ(help.exitCode, 0) << help.output;
   EXPECT_EQ(info.exitCode, 0) << info.output;
@@ -223,10 +224,10 @@ TEST_F(Cli, HugePageAdviceOnOrOffWritesTheSameStore) {
 
 // Issue 12, list item 8: every kind of failure has its exit code and a message naming the file.
 TEST_F(Cli, ExitCodesAndMessagesForEveryKindOfFailure) {
-  ASSERT_EQ(run("synth -o " + path("f.ply") + " --particles 20k").exitCode, 0);
-  ASSERT_EQ(run("convert " + path("f.ply") + " -o " + path("store") + " -q").exitCode, 0);
+  ASSERT_EQ(runFlipscope("synth -o " + path("f.ply") + " --particles 20k").exitCode, 0);
+  ASSERT_EQ(runFlipscope("convert " + path("f.ply") + " -o " + path("store") + " -q").exitCode, 0);
   auto expectRun = [&](const std::string& args, int code, const std::string& says) {
-    const CommandRun r = run(args);
+    const CommandRun r = runFlipscope(args);
     EXPECT_EQ(r.exitCode, code) << args << "\n" << r.output;
     EXPECT_NE(r.output.find(says), std::string::npos) << args << "\n" << r.output;
   };
@@ -256,15 +257,17 @@ TEST_F(Cli, ExitCodesAndMessagesForEveryKindOfFailure) {
   writeRaw("far.bin", 1e23f);
   writeRaw("tiny.bin", 0);
   for (const char* name : {"far", "tiny"})
-    ASSERT_EQ(run("convert " + path(std::string(name) + ".bin") + " -o " + path(name) + " -q").exitCode, 0) << name;
-  const CommandRun far = run("render " + path("far") + " -o " + path("far.png") + " --size 32x18 --device cpu");
+    ASSERT_EQ(runFlipscope("convert " + path(std::string(name) + ".bin") + " -o " + path(name) + " -q").exitCode, 0)
+        << name;
+  const CommandRun far =
+      runFlipscope("render " + path("far") + " -o " + path("far.png") + " --size 32x18 --device cpu");
   EXPECT_EQ(far.exitCode, 0) << far.output;
   expectRun("render " + path("tiny") + " -o " + path("tiny.png") + " --size 32x18 --device cpu", 3,
             "too far from the origin for its size");
   // info --json on a store whose path is not UTF-8: valid JSON, exit 0.
   const fs::path odd = dir / "store-\xff\xfe";
   fs::copy(dir / "store", odd, fs::copy_options::recursive);
-  const CommandRun info = run("info --json '" + odd.string() + "'");
+  const CommandRun info = runFlipscope("info --json '" + odd.string() + "'");
   EXPECT_EQ(info.exitCode, 0) << info.output;
   EXPECT_TRUE(nlohmann::json::accept(info.output)) << info.output;
 }

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "TestSupport.h"
+#include "core/Elapsed.h"
 #include "preprocess/store/BrickStore.h"
 #include "preprocess/store/StoreLock.h"
 
@@ -31,8 +32,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using flipscope::testing::CommandRun;
-
-CommandRun run(const std::string& args) { return flipscope::testing::runFlipscope(args); }
+using flipscope::testing::runFlipscope;
 
 /// Starts `flipscope args...` with FLIPSCOPE_CONVERT_STOP=`stop` (none when empty), output to
 /// `log`. Only async-signal-safe calls between fork and exec.
@@ -106,8 +106,8 @@ class ConvertInterrupt : public ::testing::Test {
  protected:
   void SetUp() override {
     for (auto [frame, count] : {std::pair{1, "2500"}, std::pair{2, "120k"}, std::pair{3, "2500"}}) {
-      CommandRun synth = run("synth -o " + (dir / "in_####.bin").string() + " --particles " + count + " --frames " +
-                             std::to_string(frame) + " --seed " + std::to_string(frame));
+      CommandRun synth = runFlipscope("synth -o " + (dir / "in_####.bin").string() + " --particles " + count +
+                                      " --frames " + std::to_string(frame) + " --seed " + std::to_string(frame));
       ASSERT_EQ(synth.exitCode, 0) << synth.output;
     }
   }
@@ -129,7 +129,7 @@ class ConvertInterrupt : public ::testing::Test {
 
   /// Frames `info --json --verify` lists; exit code in `code`.
   std::vector<int> verifiedFrames(const fs::path& store, int& code, std::string& output) {
-    CommandRun info = run("info --json --verify '" + store.string() + "'");
+    CommandRun info = runFlipscope("info --json --verify '" + store.string() + "'");
     code = info.exitCode;
     output = info.output;
     std::vector<int> frames;
@@ -167,14 +167,14 @@ class ConvertInterrupt : public ::testing::Test {
       }
     } else if (!fs::exists(store / "store.fsh")) {
       EXPECT_FALSE(existed);
-      CommandRun info = run("info '" + store.string() + "'");
+      CommandRun info = runFlipscope("info '" + store.string() + "'");
       EXPECT_EQ(info.exitCode, 3) << info.output;
     } else if (code != 0) {
       // No frame yet: incomplete, exit 3 for info, 1 for --verify.
       EXPECT_FALSE(existed) << output;
       EXPECT_EQ(code, 1) << output;
       EXPECT_NE(output.find("incomplete store: no frames"), std::string::npos) << output;
-      CommandRun info = run("info '" + store.string() + "'");
+      CommandRun info = runFlipscope("info '" + store.string() + "'");
       EXPECT_EQ(info.exitCode, 3) << info.output;
       EXPECT_NE(info.output.find("store.fsh: incomplete store"), std::string::npos) << info.output;
     } else {
@@ -186,7 +186,7 @@ class ConvertInterrupt : public ::testing::Test {
     }
 
     // The next convert removes what is stale, and finishes the store.
-    CommandRun next = run(convertCommand(store));
+    CommandRun next = runFlipscope(convertCommand(store));
     ASSERT_EQ(next.exitCode, 0) << next.output;
     if (!stale.empty()) {
       EXPECT_NE(next.output.find("removed"), std::string::npos) << join(stale) << next.output;
@@ -203,7 +203,7 @@ class ConvertInterrupt : public ::testing::Test {
   int bricksOfFrame1() {
     const fs::path store = dir / "probe";
     EXPECT_EQ(convertStopped(store, ""), 0);
-    CommandRun info = run("info --json '" + store.string() + "'");
+    CommandRun info = runFlipscope("info --json '" + store.string() + "'");
     const auto j = parseJson(info.output);
     return j["frames"][0]["bricks"].get<int>();
   }
@@ -248,7 +248,7 @@ TEST_F(ConvertInterrupt, SigintAtEveryStageLeavesNoTemporaryOrSpillFile) { stopE
 TEST_F(ConvertInterrupt, SignalsAfterIncreasingDelays) {
   const auto t0 = std::chrono::steady_clock::now();
   ASSERT_EQ(convertStopped(dir / "timing", ""), 0) << readText(dir / "log");
-  const double full = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double full = flipscope::secondsSince(t0);
   int killed = 0;
   for (int i = 1; i <= 6; ++i) {
     const int signal = i % 2 ? SIGKILL : SIGINT;
@@ -274,12 +274,13 @@ TEST_F(ConvertInterrupt, SignalsAfterIncreasingDelays) {
 class StoreIntegrityCli : public ::testing::Test {
  protected:
   void SetUp() override {
-    CommandRun synth = run("synth -o " + path("f_####.bin") + " --particles 2k --frames 1-4");
+    CommandRun synth = runFlipscope("synth -o " + path("f_####.bin") + " --particles 2k --frames 1-4");
     ASSERT_EQ(synth.exitCode, 0) << synth.output;
   }
   std::string path(const std::string& name) const { return (dir / name).string(); }
   void convert(const std::string& store, const std::string& extra = "") {
-    CommandRun c = run("convert " + path("f_####.bin") + " -o " + path(store) + " --resolution 64 -q " + extra);
+    CommandRun c =
+        runFlipscope("convert " + path("f_####.bin") + " -o " + path(store) + " --resolution 64 -q " + extra);
     ASSERT_EQ(c.exitCode, 0) << c.output;
   }
   flipscope::testing::TempDir temp{"integrity"};
@@ -290,18 +291,18 @@ TEST_F(StoreIntegrityCli, DeletedFramesAreEachReported) {
   convert("s");
   fs::remove(dir / "s" / "frame_000002.fsf");
   fs::remove(dir / "s" / "frame_000003.fsf");
-  CommandRun info = run("info " + path("s"));
+  CommandRun info = runFlipscope("info " + path("s"));
   EXPECT_EQ(info.exitCode, 3) << info.output;
   EXPECT_NE(info.output.find("frame_000002.fsf: missing: store.fsh lists frame 2"), std::string::npos) << info.output;
   EXPECT_NE(info.output.find("and 1 more listed frame(s) missing"), std::string::npos) << info.output;
-  CommandRun verify = run("info --verify " + path("s"));
+  CommandRun verify = runFlipscope("info --verify " + path("s"));
   EXPECT_EQ(verify.exitCode, 1) << verify.output;
   EXPECT_NE(verify.output.find("damaged: " + path("s/frame_000002.fsf") + ": missing"), std::string::npos)
       << verify.output;
   EXPECT_NE(verify.output.find("damaged: " + path("s/frame_000003.fsf") + ": missing"), std::string::npos)
       << verify.output;
   EXPECT_NE(verify.output.find("2 damaged or missing"), std::string::npos) << verify.output;
-  CommandRun json = run("info --json --verify " + path("s"));
+  CommandRun json = runFlipscope("info --json --verify " + path("s"));
   EXPECT_EQ(json.exitCode, 1);
   const auto j = parseJson(json.output);
   EXPECT_EQ(j["frames_missing"], nlohmann::json::array({2, 3}));
@@ -309,29 +310,29 @@ TEST_F(StoreIntegrityCli, DeletedFramesAreEachReported) {
   EXPECT_EQ(j["frames"].size(), 2u);
   // Converting the frames again mends it.
   convert("s");
-  EXPECT_EQ(run("info --verify " + path("s")).exitCode, 0);
+  EXPECT_EQ(runFlipscope("info --verify " + path("s")).exitCode, 0);
 }
 
 TEST_F(StoreIntegrityCli, AFrameOfAnotherStoreIsRefusedNamingTheFile) {
   convert("a");
   convert("b");
   const auto idOf = [&](const std::string& store) {
-    return parseJson(run("info --json " + path(store)).output)["store_id"].get<std::string>();
+    return parseJson(runFlipscope("info --json " + path(store)).output)["store_id"].get<std::string>();
   };
   const std::string idA = idOf("a"), idB = idOf("b");
   EXPECT_EQ(idA.size(), 32u);
   EXPECT_NE(idA, idB);
   fs::copy_file(dir / "a" / "frame_000002.fsf", dir / "b" / "frame_000002.fsf", fs::copy_options::overwrite_existing);
-  CommandRun verify = run("info --verify " + path("b"));
+  CommandRun verify = runFlipscope("info --verify " + path("b"));
   EXPECT_EQ(verify.exitCode, 1) << verify.output;
   EXPECT_NE(verify.output.find(path("b/frame_000002.fsf") + ": belongs to another store (its store id is " + idA +
                                ", this store's is " + idB + ")"),
             std::string::npos)
       << verify.output;
-  EXPECT_EQ(run("info " + path("b")).exitCode, 3);
+  EXPECT_EQ(runFlipscope("info " + path("b")).exitCode, 3);
   // Another store's store.fsh (same grid) over a's frames: every frame refused.
   fs::copy_file(dir / "b" / "store.fsh", dir / "a" / "store.fsh", fs::copy_options::overwrite_existing);
-  CommandRun swapped = run("info --verify " + path("a"));
+  CommandRun swapped = runFlipscope("info --verify " + path("a"));
   EXPECT_EQ(swapped.exitCode, 1) << swapped.output;
   EXPECT_NE(swapped.output.find("4 damaged or missing"), std::string::npos) << swapped.output;
 }
@@ -342,25 +343,26 @@ TEST_F(StoreIntegrityCli, AStoreWithoutFramesIsIncomplete) {
   const int status = waitFor(pid);
   ASSERT_TRUE(WIFSIGNALED(status)) << readText(dir / "log");
   ASSERT_TRUE(fs::exists(dir / "s" / "store.fsh"));
-  CommandRun info = run("info " + path("s"));
+  CommandRun info = runFlipscope("info " + path("s"));
   EXPECT_EQ(info.exitCode, 3) << info.output;
   EXPECT_NE(info.output.find(path("s/store.fsh") + ": incomplete store: no frames"), std::string::npos) << info.output;
-  CommandRun verify = run("info --verify " + path("s"));
+  CommandRun verify = runFlipscope("info --verify " + path("s"));
   EXPECT_EQ(verify.exitCode, 1) << verify.output;
   EXPECT_NE(verify.output.find("incomplete store"), std::string::npos) << verify.output;
   EXPECT_EQ(verify.output.find("intact"), std::string::npos) << verify.output;
   // The next convert starts it anew, with its own options.
-  CommandRun again = run("convert " + path("f_####.bin") + " -o " + path("s") + " --resolution 32");
+  CommandRun again = runFlipscope("convert " + path("f_####.bin") + " -o " + path("s") + " --resolution 32");
   EXPECT_EQ(again.exitCode, 0) << again.output;
   EXPECT_NE(again.output.find("has no frames"), std::string::npos) << again.output;
   EXPECT_NE(again.output.find("32 cells along the longest axis"), std::string::npos) << again.output;
-  EXPECT_EQ(run("info --verify " + path("s")).exitCode, 0);
+  EXPECT_EQ(runFlipscope("info --verify " + path("s")).exitCode, 0);
 }
 
 TEST_F(StoreIntegrityCli, AFailedConvertLeavesNoStore) {
-  CommandRun big = run("synth -o " + path("big.bin") + " --particles 200k");
+  CommandRun big = runFlipscope("synth -o " + path("big.bin") + " --particles 200k");
   ASSERT_EQ(big.exitCode, 0) << big.output;
-  CommandRun failed = run("convert " + path("big.bin") + " -o " + path("s") + " --mem 1M --scratch " + path("none/x"));
+  CommandRun failed =
+      runFlipscope("convert " + path("big.bin") + " -o " + path("s") + " --mem 1M --scratch " + path("none/x"));
   EXPECT_EQ(failed.exitCode, 3) << failed.output;
   EXPECT_NE(failed.output.find("spill"), std::string::npos) << failed.output;
   EXPECT_FALSE(fs::exists(dir / "s")) << join(namesIn(dir / "s"));
@@ -376,41 +378,42 @@ TEST_F(StoreIntegrityCli, AConvertBesideAnotherWriterLeavesItsFilesAlone) {
   {
     flipscope::StoreWriterLock other(dir / "s");  // as a running convert holds it
     other.share();
-    CommandRun beside = run("convert " + path("f_####.bin") + " --frames 2 -o " + path("s"));
+    CommandRun beside = runFlipscope("convert " + path("f_####.bin") + " --frames 2 -o " + path("s"));
     EXPECT_EQ(beside.exitCode, 0) << beside.output;
     EXPECT_TRUE(fs::exists(temporary));
     EXPECT_TRUE(fs::exists(dir / "s" / "frame_000005.fsf"));
     EXPECT_EQ(beside.output.find("removed"), std::string::npos) << beside.output;
   }
   // Alone, a convert removes both: their writer is gone.
-  CommandRun alone = run("convert " + path("f_####.bin") + " --frames 3 -o " + path("s"));
+  CommandRun alone = runFlipscope("convert " + path("f_####.bin") + " --frames 3 -o " + path("s"));
   EXPECT_EQ(alone.exitCode, 0) << alone.output;
   EXPECT_FALSE(fs::exists(temporary));
   EXPECT_FALSE(fs::exists(dir / "s" / "frame_000005.fsf"));
-  EXPECT_EQ(run("info --verify " + path("s")).exitCode, 0);
+  EXPECT_EQ(runFlipscope("info --verify " + path("s")).exitCode, 0);
 }
 
 TEST_F(StoreIntegrityCli, AppendNeedsAStoreAndPrepareMakesOneWithoutFrames) {
-  CommandRun append = run("convert " + path("f_####.bin") + " -o " + path("s") + " --append");
+  CommandRun append = runFlipscope("convert " + path("f_####.bin") + " -o " + path("s") + " --append");
   EXPECT_EQ(append.exitCode, 3) << append.output;
   EXPECT_NE(append.output.find(path("s") + ": --append: not a brick store"), std::string::npos) << append.output;
   EXPECT_FALSE(fs::exists(dir / "s"));
-  CommandRun prepare = run("convert " + path("f_####.bin") + " -o " + path("s") + " --prepare --resolution 64");
+  CommandRun prepare =
+      runFlipscope("convert " + path("f_####.bin") + " -o " + path("s") + " --prepare --resolution 64");
   ASSERT_EQ(prepare.exitCode, 0) << prepare.output;
   EXPECT_NE(prepare.output.find("no frames yet"), std::string::npos) << prepare.output;
-  EXPECT_EQ(run("info " + path("s")).exitCode, 3);  // incomplete until a frame is added
+  EXPECT_EQ(runFlipscope("info " + path("s")).exitCode, 3);  // incomplete until a frame is added
   // --append joins the prepared store (its id and header) instead of starting it anew.
   const flipscope::StoreId id = flipscope::BrickStore::open(dir / "s").header().id;
-  CommandRun first = run("convert " + path("f_####.bin") + " --frames 1 -o " + path("s") + " --append");
+  CommandRun first = runFlipscope("convert " + path("f_####.bin") + " --frames 1 -o " + path("s") + " --append");
   ASSERT_EQ(first.exitCode, 0) << first.output;
   EXPECT_EQ(first.output.find("starting it anew"), std::string::npos) << first.output;
   EXPECT_EQ(flipscope::BrickStore::open(dir / "s").header().id, id);
-  EXPECT_EQ(run("info --verify " + path("s")).exitCode, 0);
+  EXPECT_EQ(runFlipscope("info --verify " + path("s")).exitCode, 0);
 }
 
 TEST_F(StoreIntegrityCli, AnOutputPathThatCannotBeCreatedIsNamed) {
   std::ofstream(path("file")) << "x";
-  CommandRun c = run("convert " + path("f_####.bin") + " -o " + path("file/s") + " -q");
+  CommandRun c = runFlipscope("convert " + path("f_####.bin") + " -o " + path("file/s") + " -q");
   EXPECT_EQ(c.exitCode, 4) << c.output;  // an output that cannot be created
   EXPECT_NE(c.output.find(path("file/s")), std::string::npos) << c.output;
   EXPECT_EQ(c.output.find("internal error"), std::string::npos) << c.output;

@@ -14,11 +14,9 @@ namespace {
 namespace fs = std::filesystem;
 
 using flipscope::testing::CommandRun;
-CommandRun run(const std::string& args) { return flipscope::testing::runFlipscope(args); }
-
-const std::string kFlip = (fs::path(FLIPSCOPE_DATA_DIR) / "mantaflow-dam64" / "data" / "fluid_data_0030.vdb").string();
-const std::string kSecondary =
-    (fs::path(FLIPSCOPE_DATA_DIR) / "mantaflow-dam64" / "particles" / "fluid_particles_0030.vdb").string();
+using flipscope::testing::runFlipscope;
+const std::string kFlip30 = flipscope::testing::mantaflowFile("data", "fluid_data_0030.vdb").string();
+const std::string kSecondary30 = flipscope::testing::mantaflowFile("particles", "fluid_particles_0030.vdb").string();
 
 class KindsCli : public ::testing::Test {
  protected:
@@ -28,10 +26,11 @@ class KindsCli : public ::testing::Test {
 };
 
 TEST_F(KindsCli, ConvertOfFlipAndSecondaryFilesStoresKindsAndInfoCountsThem) {
-  const CommandRun convert = run("convert '" + kFlip + "' '" + kSecondary + "' -o " + path("store") + " --resolution 100");
+  const CommandRun convert =
+      runFlipscope("convert '" + kFlip30 + "' '" + kSecondary30 + "' -o " + path("store") + " --resolution 100");
   ASSERT_EQ(convert.exitCode, 0) << convert.output;
   EXPECT_NE(convert.output.find("particle kinds"), std::string::npos) << convert.output;
-  const CommandRun json = run("info --json --verify " + path("store"));
+  const CommandRun json = runFlipscope("info --json --verify " + path("store"));
   ASSERT_EQ(json.exitCode, 0) << json.output;
   const auto j = nlohmann::json::parse(json.output);
   EXPECT_EQ(j["particle_kinds"], true);
@@ -44,7 +43,7 @@ TEST_F(KindsCli, ConvertOfFlipAndSecondaryFilesStoresKindsAndInfoCountsThem) {
   }
   EXPECT_EQ(j["frames"][0]["kind_cells"], cells);
   EXPECT_EQ(sum, j["frames"][0]["occupied_cells"].get<std::uint64_t>()) << "every occupied cell has one kind";
-  const CommandRun text = run("info " + path("store"));
+  const CommandRun text = runFlipscope("info " + path("store"));
   ASSERT_EQ(text.exitCode, 0) << text.output;
   const std::string counts = "liquid " + std::to_string(cells["liquid"].get<std::uint64_t>()) + ", foam " +
                              std::to_string(cells["foam"].get<std::uint64_t>());
@@ -53,37 +52,39 @@ TEST_F(KindsCli, ConvertOfFlipAndSecondaryFilesStoresKindsAndInfoCountsThem) {
       << text.output;
 
   // --kind-attribute none: no kinds, and info says so.
-  ASSERT_EQ(run("convert '" + kFlip + "' '" + kSecondary + "' -o " + path("none") + " --kind-attribute none -q").exitCode,
-            0);
-  const auto none = nlohmann::json::parse(run("info --json " + path("none")).output);
+  ASSERT_EQ(
+      runFlipscope("convert '" + kFlip30 + "' '" + kSecondary30 + "' -o " + path("none") + " --kind-attribute none -q")
+          .exitCode,
+      0);
+  const auto none = nlohmann::json::parse(runFlipscope("info --json " + path("none")).output);
   EXPECT_EQ(none["particle_kinds"], false);
   EXPECT_TRUE(none["total"]["kind_cells"].is_null());
-  EXPECT_NE(run("info " + path("none")).output.find("kinds      none"), std::string::npos);
+  EXPECT_NE(runFlipscope("info " + path("none")).output.find("kinds      none"), std::string::npos);
 }
 
 TEST_F(KindsCli, InspectNamesTheKindAttributeOfTheSecondaryFileOnly) {
-  const CommandRun secondary = run("inspect '" + kSecondary + "'");
+  const CommandRun secondary = runFlipscope("inspect '" + kSecondary30 + "'");
   ASSERT_EQ(secondary.exitCode, 0) << secondary.output;
   EXPECT_NE(secondary.output.find("kinds       U: particle types"), std::string::npos) << secondary.output;
-  const CommandRun flip = run("inspect --json '" + kFlip + "'");
+  const CommandRun flip = runFlipscope("inspect --json '" + kFlip30 + "'");
   ASSERT_EQ(flip.exitCode, 0) << flip.output;
   EXPECT_TRUE(nlohmann::json::parse(flip.output)[0]["kind_attribute"].is_null()) << "U of the FLIP grid 'particles'";
 }
 
 TEST_F(KindsCli, KindAttributeErrorsExitWithTheirCodesNamingOptionAndFile) {
   const CommandRun unknown =
-      run("convert '" + kFlip + "' '" + kSecondary + "' -o " + path("a") + " --kind-attribute nosuch -q");
+      runFlipscope("convert '" + kFlip30 + "' '" + kSecondary30 + "' -o " + path("a") + " --kind-attribute nosuch -q");
   EXPECT_EQ(unknown.exitCode, 3) << unknown.output;
   EXPECT_NE(unknown.output.find("--kind-attribute"), std::string::npos) << unknown.output;
-  EXPECT_NE(unknown.output.find(kFlip), std::string::npos) << unknown.output;
+  EXPECT_NE(unknown.output.find(kFlip30), std::string::npos) << unknown.output;
   EXPECT_NE(unknown.output.find("'nosuch'"), std::string::npos) << unknown.output;
   const CommandRun floating =
-      run("convert '" + kSecondary + "' -o " + path("b") + " --kind-attribute particles_life_secondary -q");
+      runFlipscope("convert '" + kSecondary30 + "' -o " + path("b") + " --kind-attribute particles_life_secondary -q");
   EXPECT_EQ(floating.exitCode, 3) << floating.output;
   EXPECT_NE(floating.output.find("--kind-attribute: attribute 'particles_life_secondary' is float32"), std::string::npos)
       << floating.output;
-  EXPECT_NE(floating.output.find(kSecondary), std::string::npos) << floating.output;
-  const CommandRun empty = run("convert '" + kSecondary + "' -o " + path("c") + " --kind-attribute '' -q");
+  EXPECT_NE(floating.output.find(kSecondary30), std::string::npos) << floating.output;
+  const CommandRun empty = runFlipscope("convert '" + kSecondary30 + "' -o " + path("c") + " --kind-attribute '' -q");
   EXPECT_EQ(empty.exitCode, 2) << empty.output;
   EXPECT_NE(empty.output.find("--kind-attribute"), std::string::npos) << empty.output;
   EXPECT_FALSE(fs::exists(dir / "a") || fs::exists(dir / "b") || fs::exists(dir / "c"));

@@ -17,9 +17,8 @@ namespace {
 using flipscope::testing::CommandRun;
 using flipscope::testing::runFlipscope;
 
-const std::string kData = std::string(FLIPSCOPE_DATA_DIR) + "/mantaflow-dam64/";
-const std::string kFlip = kData + "data/fluid_data_0009.vdb";
-const std::string kSecondary = kData + "particles/fluid_particles_0009.vdb";
+const std::string kFlip9 = flipscope::testing::mantaflowFile("data", "fluid_data_0009.vdb").string();
+const std::string kSecondary9 = flipscope::testing::mantaflowFile("particles", "fluid_particles_0009.vdb").string();
 
 flipscope::RenderImage convertAndRender(const flipscope::testing::TempDir& dir, const std::string& name,
                                         const std::string& inputs, const std::string& renderOptions) {
@@ -51,14 +50,15 @@ TEST(MantaflowFoam, FlipAndSecondaryParticlesShowTheLiquidSurface) {
   // The camera of the FLIP frame's default render.
   {
     const std::string store = (dir.path() / "camera-store").string();
-    ASSERT_EQ(runFlipscope("convert " + kFlip + " -o " + store + " -q").exitCode, 0);
+    ASSERT_EQ(runFlipscope("convert " + kFlip9 + " -o " + store + " -q").exitCode, 0);
     CommandRun camera = runFlipscope("render " + store + " -o " + (dir.path() / "c.png").string() +
                                      " --up z --size 320x180 -q --save-camera " + (dir.path() / "camera.json").string());
     ASSERT_EQ(camera.exitCode, 0) << camera.output;
   }
-  const flipscope::RenderImage flip = convertAndRender(dir, "flip", kFlip, "--foam keep");
-  const flipscope::RenderImage both = convertAndRender(dir, "both", kFlip + " " + kSecondary, "");
-  const flipscope::RenderImage secondary = convertAndRender(dir, "secondary", kSecondary, "--foam keep --bubbles show");
+  const flipscope::RenderImage flip = convertAndRender(dir, "flip", kFlip9, "--foam keep");
+  const flipscope::RenderImage both = convertAndRender(dir, "both", kFlip9 + " " + kSecondary9, "");
+  const flipscope::RenderImage secondary =
+      convertAndRender(dir, "secondary", kSecondary9, "--foam keep --bubbles show");
   // One particle spacing (0.0307 world units). The bubbles fill the body, so their own surface lies
   // near the liquid's; at three spacings it would pass for it in 71% of the pixels.
   constexpr double kTolerance = 0.0307;
@@ -82,7 +82,7 @@ namespace {
 TEST(MantaflowFoam, FoamSourceAndBubbleOptionsChangeTheImage) {
   flipscope::testing::TempDir dir("mantaflow-foam-options");
   const std::string store = (dir.path() / "store").string();
-  ASSERT_EQ(runFlipscope("convert " + kFlip + " " + kSecondary + " -o " + store + " -q").exitCode, 0);
+  ASSERT_EQ(runFlipscope("convert " + kFlip9 + " " + kSecondary9 + " -o " + store + " -q").exitCode, 0);
   const auto render = [&](const std::string& name, const std::string& options) {
     const std::string image = (dir.path() / (name + ".exr")).string();
     CommandRun r = runFlipscope("render " + store + " -o " + image + " --up z --size 160x90 -q " + options);

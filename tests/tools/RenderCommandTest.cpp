@@ -17,8 +17,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using flipscope::testing::CommandRun;
-CommandRun run(const std::string& args) { return flipscope::testing::runFlipscope(args); }
-
+using flipscope::testing::runFlipscope;
 /// Width and height from a PNG's IHDR chunk (bytes 16 to 23, big-endian), {0, 0} if not a PNG.
 std::pair<std::uint32_t, std::uint32_t> pngSize(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
@@ -35,15 +34,16 @@ std::pair<std::uint32_t, std::uint32_t> pngSize(const fs::path& file) {
 class Render : public ::testing::Test {
  protected:
   void SetUp() override {
-    ASSERT_EQ(run("synth -o " + path("f_####.bin") + " --particles 30k --frames 0-1").exitCode, 0);
+    ASSERT_EQ(runFlipscope("synth -o " + path("f_####.bin") + " --particles 30k --frames 0-1").exitCode, 0);
     CommandRun convert =
-        run("convert " + path("f_####.bin") + " -o " + path("store") + " --resolution 96 --brick-size 32 -q");
+        runFlipscope("convert " + path("f_####.bin") + " -o " + path("store") + " --resolution 96 --brick-size 32 -q");
     ASSERT_EQ(convert.exitCode, 0) << convert.output;
   }
   std::string path(const std::string& name) const { return (dir / name).string(); }
   /// Renders the store at 64x36 on the CPU with `options` into `name` and reads it back.
   flipscope::ExrContents renderExr(const std::string& name, const std::string& options) {
-    CommandRun r = run("render " + path("store") + " -o " + path(name) + " --size 64x36 --device cpu " + options);
+    CommandRun r =
+        runFlipscope("render " + path("store") + " -o " + path(name) + " --size 64x36 --device cpu " + options);
     EXPECT_EQ(r.exitCode, 0) << options << "\n" << r.output;
     return flipscope::readExr(path(name));
   }
@@ -52,11 +52,12 @@ class Render : public ::testing::Test {
 };
 
 TEST_F(Render, WritesPngAndExrWithDepthAndNormals) {
-  CommandRun png = run("render " + path("store") + " -o " + path("a.png") + " --size 64x36 --device cpu");
+  CommandRun png = runFlipscope("render " + path("store") + " -o " + path("a.png") + " --size 64x36 --device cpu");
   ASSERT_EQ(png.exitCode, 0) << png.output;
   EXPECT_EQ(pngSize(path("a.png")), std::make_pair(64u, 36u));
 
-  CommandRun exr = run("render " + path("store") + " -o " + path("a.exr") + " --size 64x36 --frame 1 --jitter off");
+  CommandRun exr =
+      runFlipscope("render " + path("store") + " -o " + path("a.exr") + " --size 64x36 --frame 1 --jitter off");
   ASSERT_EQ(exr.exitCode, 0) << exr.output;
   const flipscope::ExrContents contents = flipscope::readExr(path("a.exr"));
   for (const char* channel : {"R", "G", "B", "A", "Z", "N.X", "N.Y", "N.Z", "unsmoothed.Z", "thickness"})
@@ -78,19 +79,20 @@ TEST_F(Render, WritesPngAndExrWithDepthAndNormals) {
 }
 
 TEST_F(Render, FlipbookAndCameraOptions) {
-  CommandRun seq = run("render " + path("store") + " -o " + path("seq_####.png") + " --frames 0-1 --size 32x18");
+  CommandRun seq =
+      runFlipscope("render " + path("store") + " -o " + path("seq_####.png") + " --frames 0-1 --size 32x18");
   ASSERT_EQ(seq.exitCode, 0) << seq.output;
   EXPECT_TRUE(fs::exists(path("seq_0000.png")));
   EXPECT_TRUE(fs::exists(path("seq_0001.png")));
 
   std::ofstream(path("cam.json")) << R"({"eye": [0.5, 0.4, 3.0], "target": [0.5, 0.2, 0.5], "fov": 35})";
-  CommandRun file =
-      run("render " + path("store") + " -o " + path("cam.png") + " --size 32x18 --camera-file " + path("cam.json"));
+  CommandRun file = runFlipscope("render " + path("store") + " -o " + path("cam.png") + " --size 32x18 --camera-file " +
+                                 path("cam.json"));
   EXPECT_EQ(file.exitCode, 0) << file.output;
-  CommandRun inline_ = run("render " + path("store") + " -o " + path("cam2.png") +
-                           " --size 32x18 --camera 0.5,0.4,3,0.5,0.2,0.5,0,1,0,35");
+  CommandRun inline_ = runFlipscope("render " + path("store") + " -o " + path("cam2.png") +
+                                    " --size 32x18 --camera 0.5,0.4,3,0.5,0.2,0.5,0,1,0,35");
   EXPECT_EQ(inline_.exitCode, 0) << inline_.output;
-  CommandRun framed = run("render " + path("store") + " -o " + path("framed.png") + " --size 32x18");
+  CommandRun framed = runFlipscope("render " + path("store") + " -o " + path("framed.png") + " --size 32x18");
   EXPECT_EQ(framed.exitCode, 0) << framed.output;
   const auto bytes = [&](const std::string& name) {
     std::ifstream in(path(name), std::ios::binary);
@@ -106,9 +108,10 @@ TEST_F(Render, FlipbookAndCameraOptions) {
 TEST_F(Render, AHoudiniFileRendersWithDefaults) {
   const fs::path houdini =
       fs::path(FLIPSCOPE_DATA_DIR) / "formats" / "houdini-bgeo-sc" / "delete_small_parts_demoscene.1.bgeo.sc";
-  CommandRun convert = run("convert '" + houdini.string() + "' -o " + path("houdini") + " -q");
+  CommandRun convert = runFlipscope("convert '" + houdini.string() + "' -o " + path("houdini") + " -q");
   ASSERT_EQ(convert.exitCode, 0) << convert.output;
-  CommandRun render = run("render " + path("houdini") + " -o " + path("houdini.exr") + " --size 64x36 --device cpu");
+  CommandRun render =
+      runFlipscope("render " + path("houdini") + " -o " + path("houdini.exr") + " --size 64x36 --device cpu");
   ASSERT_EQ(render.exitCode, 0) << render.output;
   const flipscope::RenderImage image = flipscope::readExr(path("houdini.exr")).image;
   std::size_t covered = 0;
@@ -158,7 +161,7 @@ TEST_F(Render, FoamOptionsChangeTheImageAndTheExrHasAFoamLayer) {
 TEST_F(Render, BadInputsGiveClearErrors) {
   // Exit code 2: a bad option or value; 3: an unreadable or damaged file.
   const auto expectError = [&](const std::string& args, const std::string& needle, int code = 2) {
-    CommandRun r = run("render " + args);
+    CommandRun r = runFlipscope("render " + args);
     EXPECT_EQ(r.exitCode, code) << args << "\n" << r.output;
     EXPECT_NE(r.output.find(needle), std::string::npos) << args << "\n" << r.output;
   };
@@ -202,7 +205,8 @@ TEST_F(Render, BadInputsGiveClearErrors) {
 
 TEST(Demo, RendersAPreviewImage) {
   flipscope::testing::TempDir temp("demo");
-  CommandRun demo = run("demo -o " + (temp.path() / "out").string() + " --particles 50k --frames 2 --size 96x54");
+  CommandRun demo =
+      runFlipscope("demo -o " + (temp.path() / "out").string() + " --particles 50k --frames 2 --size 96x54");
   ASSERT_EQ(demo.exitCode, 0) << demo.output;
   EXPECT_EQ(pngSize(temp.path() / "out" / "preview.png"), std::make_pair(96u, 54u));
   EXPECT_NE(demo.output.find("preview.png"), std::string::npos) << demo.output;

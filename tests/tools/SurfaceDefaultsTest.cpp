@@ -77,7 +77,7 @@ Coverage measureHoles(const flipscope::RenderImage& image) {
   return c;
 }
 
-Coverage convertAndRender(const flipscope::testing::TempDir& dir, const std::string& name,
+Coverage coverageOfRender(const flipscope::testing::TempDir& dir, const std::string& name,
                           const std::string& convertOptions, const std::string& renderOptions) {
   const std::string vdb = std::string(FLIPSCOPE_DATA_DIR) + "/mantaflow-dam64/data/fluid_data_0030.vdb";
   const std::string store = (dir.path() / name).string(), image = (dir.path() / (name + ".exr")).string();
@@ -90,18 +90,18 @@ Coverage convertAndRender(const flipscope::testing::TempDir& dir, const std::str
 
 TEST(SurfaceDefaults, MantaflowFrameRendersClosedWithDefaultSettings) {
   flipscope::testing::TempDir dir("surface-defaults");
-  const Coverage defaults = convertAndRender(dir, "defaults", "", "");
+  const Coverage defaults = coverageOfRender(dir, "defaults", "", "");
   EXPECT_GT(defaults.foreground, 320u * 180u / 20) << "the default camera frames the liquid";
   EXPECT_LT(defaults.holeFraction(), 0.001) << defaults.holes << " hole pixels in " << defaults.foreground;
   std::printf("defaults: %zu small-hole pixels in %zu foreground pixels\n", defaults.holes, defaults.foreground);
   // Without foam classification every particle is a sphere: the surface alone is closed.
-  const Coverage spheres = convertAndRender(dir, "keep", "", "--foam keep");
+  const Coverage spheres = coverageOfRender(dir, "keep", "", "--foam keep");
   EXPECT_LT(spheres.holeFraction(), 0.001) << spheres.holes << " hole pixels in " << spheres.foreground;
   std::printf("--foam keep: %zu small-hole pixels in %zu foreground pixels\n", spheres.holes, spheres.foreground);
 
   // The old defaults leave the body full of holes: the measure sees them. (Spheres of a quarter
   // particle spacing touch no neighbour: the classification would take every one for foam.)
-  const Coverage old = convertAndRender(dir, "old", "--resolution 1024", "--radius 1 --foam keep");
+  const Coverage old = coverageOfRender(dir, "old", "--resolution 1024", "--radius 1 --foam keep");
   std::printf("old defaults: %zu small-hole pixels in %zu foreground pixels\n", old.holes, old.foreground);
   EXPECT_GT(old.holeFraction(), 0.02) << old.holes << " hole pixels in " << old.foreground;
 }
