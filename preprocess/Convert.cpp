@@ -255,6 +255,7 @@ class FrameBinner {
               std::filesystem::path scratchDir, int frame, std::optional<std::uint64_t> expectedParticles)
       : mGrid(grid),
         mSpillFromStart(expectedParticles && *expectedParticles > plan.maxBinParticles),
+        mExpectedParticles(expectedParticles),
         mValues(grid.valuesBesideKeys()),
         mPlan(plan),
         mOptions(options),
@@ -271,9 +272,13 @@ class FrameBinner {
       mSpill->add(mBatch.cellKeys.data(), mBatch.values.data(), mBatch.cellKeys.size());
       return;
     }
-    if (mKeys.cellKeys.capacity() == 0) {  // reserve address space once: no reallocation copies
-      mKeys.cellKeys.reserve(mPlan.maxBinParticles + mPlan.chunkParticles);
-      if (mValues) mKeys.values.reserve(mPlan.maxBinParticles + mPlan.chunkParticles);
+    if (mKeys.cellKeys.capacity() == 0) {
+      // Address space for every key once (no reallocation copies): the budget's worth, or the
+      // frame's, when its source tells (a sanitizer's allocator fills shadow for all of it).
+      const std::uint64_t keys =
+          std::min(mPlan.maxBinParticles, mExpectedParticles.value_or(mPlan.maxBinParticles)) + mPlan.chunkParticles;
+      mKeys.cellKeys.reserve(keys);
+      if (mValues) mKeys.values.reserve(keys);
     }
     account(detail::computeKeys(chunk, mGrid, mKeys, types));
     if (mKeys.cellKeys.size() > mPlan.maxBinParticles) startSpilling();
@@ -386,6 +391,7 @@ class FrameBinner {
 
   const KeyGrid& mGrid;
   bool mSpillFromStart;  ///< the source's count says the frame will not fit in memory
+  std::optional<std::uint64_t> mExpectedParticles;  ///< the source's count hint, if any
   bool mValues;          ///< KeyGrid::valuesBesideKeys()
   MemoryPlan mPlan;
   const ConvertOptions& mOptions;

@@ -19,9 +19,11 @@ class VectorSource : public ParticleSource {
   std::string format() const override { return "particles in memory"; }
   bool hasVelocity() const override { return !mVelocities.empty(); }
   std::optional<std::uint64_t> countHint() const override {
-    return hintsCount ? std::optional<std::uint64_t>(mPositions.size()) : std::nullopt;
+    if (!hintsCount) return std::nullopt;
+    return wrongCount.value_or(mPositions.size());
   }
   bool hintsCount = true;  ///< whether countHint() gives the count
+  std::optional<std::uint64_t> wrongCount;  ///< what countHint() gives instead (a header that lies)
   bool read(ParticleChunk& chunk, std::size_t maxParticles) override {
     chunk.clear();
     const std::size_t n = std::min(maxParticles, mPositions.size() - mNext);
