@@ -282,7 +282,7 @@ TEST(Convert, DomainIsDerivedFromTheBoundsAndLimited) {
   EXPECT_THROW(makeStoreHeader(Box{}, ConvertOptions{}), InputError);
 }
 
-fs::path mantaflowFrame30() { return fs::path(FLIPSCOPE_DATA_DIR) / "mantaflow-dam64" / "data" / "fluid_data_0030.vdb"; }
+fs::path mantaflowFrame30() { return flipscope::testing::mantaflowFile("data", "fluid_data_0030.vdb"); }
 
 void writeRaw(const fs::path& path, const std::vector<glm::vec3>& positions) {
   auto writer = createParticleWriter(path);

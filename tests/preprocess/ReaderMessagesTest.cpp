@@ -8,6 +8,7 @@
 #include <string>
 
 #include "ParticleTestSupport.h"
+#include "TestSupport.h"
 
 namespace flipscope {
 namespace {
@@ -58,8 +59,7 @@ TEST(AsciiPly, CutInsideTheLastNumberIsRefused) {
 
 TEST(EmptyInput, ConvertNamesTheFile) {
   TempDir dir("empty-input");
-  const fs::path mantaflow =
-      fs::path(FLIPSCOPE_DATA_DIR) / "mantaflow-dam64" / "particles" / "fluid_particles_0001.vdb";
+  const fs::path mantaflow = flipscope::testing::mantaflowFile("particles", "fluid_particles_0001.vdb");
   ASSERT_TRUE(fs::exists(mantaflow));
   EXPECT_EQ(testing::readFile(mantaflow).size(), 0u);  // a real, valid, empty frame
   testing::writeBytes(dir / "empty.bin", "");

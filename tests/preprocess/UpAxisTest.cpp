@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "ParticleTestSupport.h"
+#include "TestSupport.h"
 #include "core/Hash.h"
 #include "preprocess/Convert.h"
 
@@ -17,8 +18,8 @@ namespace fs = std::filesystem;
 using testing::TempDir;
 
 const fs::path kData = FLIPSCOPE_DATA_DIR;
-const fs::path kMantaflowFlip = kData / "mantaflow-dam64" / "data" / "fluid_data_0030.vdb";
-const fs::path kMantaflowSecondary = kData / "mantaflow-dam64" / "particles" / "fluid_particles_0030.vdb";
+const fs::path kMantaflowFlip = testing::mantaflowFile("data", "fluid_data_0030.vdb");
+const fs::path kMantaflowSecondary = testing::mantaflowFile("particles", "fluid_particles_0030.vdb");
 
 fs::path writePly(const fs::path& path) {
   testing::writeBytes(path,

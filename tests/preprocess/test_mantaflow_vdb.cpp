@@ -11,6 +11,7 @@
 #include <filesystem>
 
 #include "ParticleTestSupport.h"
+#include "TestSupport.h"
 
 namespace flipscope {
 namespace {
@@ -83,7 +84,7 @@ TEST(MantaflowVdb, CountsMatchOpenVdbAndPositionsLieInTheGrid) {
 }
 
 TEST(MantaflowVdb, GridsSelectedByName) {
-  auto path = std::filesystem::path(FLIPSCOPE_DATA_DIR) / "mantaflow-dam64/data/fluid_data_0030.vdb";
+  auto path = flipscope::testing::mantaflowFile("data", "fluid_data_0030.vdb");
   ASSERT_TRUE(std::filesystem::exists(path)) << "no " << path;
   ReadOptions options;
   options.grids = {"particles"};

@@ -20,6 +20,7 @@ namespace {
 namespace fs = std::filesystem;
 using flipscope::testing::CommandRun;
 using flipscope::testing::runFlipscope;
+
 /// temperature of the particle at x: 10 x - 3 (x in 0.025 .. 0.975).
 float temperatureAt(float x) { return 10.0f * x - 3.0f; }
 

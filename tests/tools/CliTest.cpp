@@ -14,6 +14,7 @@ namespace fs = std::filesystem;
 
 using flipscope::testing::CommandRun;
 using flipscope::testing::runFlipscope;
+
 /// A frame file's bytes but for the store id (random per store) and the index checksum over it:
 /// the footer's bytes 40 to 24 and 16 to 8 from the end of the file, zeroed. `id`: what was there.
 std::string frameBytesWithoutStoreId(const fs::path& frameFile, std::string* id = nullptr) {
@@ -65,7 +66,7 @@ TEST_F(Cli, SynthConvertInfoRoundTrip) {
 }
 
 TEST_F(Cli, DefaultConvertOfMantaflowMakesOneCellPerParticleSpacingAndInfoShowsIt) {
-  const fs::path vdb = fs::path(FLIPSCOPE_DATA_DIR) / "mantaflow-dam64" / "data" / "fluid_data_0030.vdb";
+  const fs::path vdb = flipscope::testing::mantaflowFile("data", "fluid_data_0030.vdb");
   ASSERT_TRUE(fs::exists(vdb)) << vdb;
   CommandRun convert = runFlipscope("convert '" + vdb.string() + "' -o " + path("store"));
   ASSERT_EQ(convert.exitCode, 0) << convert.output;
@@ -100,7 +101,7 @@ TEST_F(Cli, DefaultConvertOfMantaflowMakesOneCellPerParticleSpacingAndInfoShowsI
 }
 
 TEST_F(Cli, TheStoresUpAxisOrientsRenderUnlessGivenUp) {
-  const fs::path vdb = fs::path(FLIPSCOPE_DATA_DIR) / "mantaflow-dam64" / "data" / "fluid_data_0030.vdb";
+  const fs::path vdb = flipscope::testing::mantaflowFile("data", "fluid_data_0030.vdb");
   CommandRun inspect = runFlipscope("inspect '" + vdb.string() + "'");
   ASSERT_EQ(inspect.exitCode, 0) << inspect.output;
   EXPECT_NE(inspect.output.find("up axis     z (the file's conventions"), std::string::npos) << inspect.output;

@@ -15,6 +15,7 @@ namespace fs = std::filesystem;
 
 using flipscope::testing::CommandRun;
 using flipscope::testing::runFlipscope;
+
 const std::string kFlip30 = flipscope::testing::mantaflowFile("data", "fluid_data_0030.vdb").string();
 const std::string kSecondary30 = flipscope::testing::mantaflowFile("particles", "fluid_particles_0030.vdb").string();
 

@@ -18,6 +18,7 @@ namespace {
 namespace fs = std::filesystem;
 using flipscope::testing::CommandRun;
 using flipscope::testing::runFlipscope;
+
 /// Width and height from a PNG's IHDR chunk (bytes 16 to 23, big-endian), {0, 0} if not a PNG.
 std::pair<std::uint32_t, std::uint32_t> pngSize(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);

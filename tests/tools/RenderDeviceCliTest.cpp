@@ -16,7 +16,7 @@ using flipscope::testing::runFlipscope;
 
 TEST(RenderDeviceCli, TheFastCpuDeviceRendersTheReferencesImage) {
   flipscope::testing::TempDir dir("device");
-  const fs::path vdb = fs::path(FLIPSCOPE_DATA_DIR) / "mantaflow-dam64" / "data" / "fluid_data_0030.vdb";
+  const fs::path vdb = flipscope::testing::mantaflowFile("data", "fluid_data_0030.vdb");
   const auto store = (dir.path() / "store").string();
   ASSERT_EQ(runFlipscope("convert '" + vdb.string() + "' -o " + store + " -q").exitCode, 0);
   flipscope::RenderImage images[2];

@@ -79,7 +79,7 @@ Coverage measureHoles(const flipscope::RenderImage& image) {
 
 Coverage coverageOfRender(const flipscope::testing::TempDir& dir, const std::string& name,
                           const std::string& convertOptions, const std::string& renderOptions) {
-  const std::string vdb = std::string(FLIPSCOPE_DATA_DIR) + "/mantaflow-dam64/data/fluid_data_0030.vdb";
+  const std::string vdb = flipscope::testing::mantaflowFile("data", "fluid_data_0030.vdb").string();
   const std::string store = (dir.path() / name).string(), image = (dir.path() / (name + ".exr")).string();
   CommandRun convert = runFlipscope("convert " + vdb + " -o " + store + " -q " + convertOptions);
   EXPECT_EQ(convert.exitCode, 0) << convert.output;

@@ -25,9 +25,8 @@ namespace {
 
 using testing::runFlipscope;
 
-const std::string kData = FLIPSCOPE_DATA_DIR;
-const std::string kFrame30 = "'" + kData + "/mantaflow-dam64/data/fluid_data_0030.vdb' '" + kData +
-                             "/mantaflow-dam64/particles/fluid_particles_0030.vdb'";
+const std::string kFrame30 = "'" + flipscope::testing::mantaflowFile("data", "fluid_data_0030.vdb").string() + "' '" +
+                             flipscope::testing::mantaflowFile("particles", "fluid_particles_0030.vdb").string() + "'";
 
 void writeText(const std::filesystem::path& path, const std::string& text) { std::ofstream(path) << text; }
 
