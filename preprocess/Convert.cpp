@@ -254,7 +254,6 @@ class FrameBinner {
   FrameBinner(const KeyGrid& grid, const MemoryPlan& plan, const ConvertOptions& options,
               std::filesystem::path scratchDir, int frame, std::optional<std::uint64_t> expectedParticles)
       : mGrid(grid),
-        mSpillFromStart(expectedParticles && *expectedParticles > plan.maxBinParticles),
         mExpectedParticles(expectedParticles),
         mValues(grid.valuesBesideKeys()),
         mPlan(plan),
@@ -265,7 +264,9 @@ class FrameBinner {
   /// With particle kinds, the chunk's last column holds the type flags (convertFrame).
   void add(const ParticleChunk& chunk) {
     const AttributeColumn* types = mGrid.header.particleKinds ? &chunk.attributes.back() : nullptr;
-    if (!mSpill && mSpillFromStart) startSpilling();  // binning in memory first would only add memory
+    // The source's count says the frame will not fit in memory: binning in memory first would
+    // only add memory.
+    if (!mSpill && mExpectedParticles && *mExpectedParticles > mPlan.maxBinParticles) startSpilling();
     if (mSpill) {
       mBatch.clear();
       account(detail::computeKeys(chunk, mGrid, mBatch, types));
@@ -390,7 +391,6 @@ class FrameBinner {
   }
 
   const KeyGrid& mGrid;
-  bool mSpillFromStart;  ///< the source's count says the frame will not fit in memory
   std::optional<std::uint64_t> mExpectedParticles;  ///< the source's count hint, if any
   bool mValues;          ///< KeyGrid::valuesBesideKeys()
   MemoryPlan mPlan;

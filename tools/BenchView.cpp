@@ -31,6 +31,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
+
 struct BenchViewArgs {
   std::string particles = "1M";
   int frames = 8;
