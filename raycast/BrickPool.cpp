@@ -9,6 +9,10 @@
 
 namespace flipscope {
 
+namespace {
+constexpr std::uint64_t kMinSlots = 3;  // with attributes, 3 x 35% fill holds any one brick
+}  // namespace
+
 std::uint64_t PoolLayout::slotBytes() const {
   return std::uint64_t(subBricksPerSlot) * (16 + (attributes ? 4 : 0) + (foam ? 16 : 0) + (marchTables ? 5 : 0)) +
          std::uint64_t(mipWordsPerSlot + (foam ? foamOccupancyWords() : 0)) * 4 +
@@ -28,10 +32,8 @@ PoolLayout PoolLayout::forBudget(std::uint32_t brickSize, std::uint32_t overlap,
   layout.mipLevels = bitBrickMipLevelCount(brickSize, overlap);
   layout.mipWordsPerSlot = bitBrickMipWordOffset(layout.mipLevels + 1, brickSize, overlap);
   layout.attributes = attributes;
-  const std::uint64_t storedCells = std::uint64_t(layout.subBricksPerSlot) * 128;
-  const std::uint64_t ringPerSlot = attributes ? (storedCells * 35 / 100) * 2 : 0;
+  const std::uint64_t ringPerSlot = attributes ? (layout.storedCellsPerSlot() * 35 / 100) * 2 : 0;
   const std::uint64_t perSlot = layout.slotBytes() + ringPerSlot;
-  constexpr std::uint64_t kMinSlots = 3;  // with attributes, 3 x 35% fill holds any one brick
   if (budgetBytes < kMinSlots * perSlot)
     throw InputError("GPU memory budget of " + std::to_string(budgetBytes) + " bytes is below the minimum of " +
                      std::to_string(kMinSlots * perSlot) + " bytes (3 bricks of " + std::to_string(brickSize) +
@@ -39,6 +41,18 @@ PoolLayout PoolLayout::forBudget(std::uint32_t brickSize, std::uint32_t overlap,
   const std::uint64_t slots = std::min<std::uint64_t>(budgetBytes / perSlot, 1u << 30);
   layout.slots = std::uint32_t(slots);
   layout.attributeCapacity = attributes ? ((budgetBytes - slots * layout.slotBytes()) / 2) & ~std::uint64_t(1) : 0;
+  return layout;
+}
+
+PoolLayout PoolLayout::withSlots(std::uint64_t wanted) const {
+  wanted = std::max(wanted, kMinSlots);
+  if (wanted >= slots) return *this;
+  PoolLayout layout = *this;
+  layout.slots = std::uint32_t(wanted);
+  if (attributes) {
+    const std::uint64_t freed = (bytes() - wanted * slotBytes()) / 2;
+    layout.attributeCapacity = std::min(freed, wanted * storedCellsPerSlot()) & ~std::uint64_t(1);
+  }
   return layout;
 }
 

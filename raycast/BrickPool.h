@@ -43,12 +43,19 @@ struct PoolLayout {
   /// foam) the foam bits and their occupancy, and (with marchTables) the fast CPU device's tables.
   std::uint64_t slotBytes() const;
   std::uint64_t bytes() const { return slotBytes() * slots + attributeCapacity * 2; }
+  /// Cells a slot stores, the border included: the most attributes one brick can have.
+  std::uint64_t storedCellsPerSlot() const { return std::uint64_t(subBricksPerSlot) * 128; }
   /// The largest pool within `budgetBytes`; with attributes, the ring gets room for about 35%
   /// filled bricks. Throws InputError when fewer than 3 slots fit (naming the minimum budget).
   /// With `marchTables`, the tables are for spheres of `reach` (sphereReach) cells.
   static PoolLayout forBudget(std::uint32_t brickSize, std::uint32_t overlap, bool attributes,
                               std::uint64_t budgetBytes, bool foam = false, bool marchTables = false,
                               std::uint32_t reach = 0);
+  /// This (budget's) pool cut to `wanted` slots (at least 3) when it has more: bricks no frame
+  /// asked for cost no memory. The ring then holds every stored cell of every slot, within the
+  /// bytes the slots left free; the pool is never larger than this one. `*this` when `wanted`
+  /// is not below its slots.
+  PoolLayout withSlots(std::uint64_t wanted) const;
 };
 
 class BrickPool {

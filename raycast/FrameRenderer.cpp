@@ -78,8 +78,9 @@ StreamerOptions streamerOptions(const StoreHeader& header, const RenderSettings&
   return options;
 }
 
-/// The pool within the budget, shrunk until its largest buffer (the bits) fits the device.
-PoolLayout poolLayout(const StoreHeader& header, const RenderSettings& settings, const RaycastDevice& device) {
+/// The largest pool within the budget, shrunk until its largest buffer (the bits) fits the
+/// device.
+PoolLayout budgetPoolLayout(const StoreHeader& header, const RenderSettings& settings, const RaycastDevice& device) {
   const std::uint64_t maxBufferBytes = device.maxBufferBytes();
   validate(settings);
   const bool attributes = header.attribute != AttributeKind::None;
@@ -110,7 +111,8 @@ FrameRenderer::FrameRenderer(std::shared_ptr<BrickSource> source, std::unique_pt
       mSettings(settings),
       mReach(sphereReach(settings.radius, settings.jitter)),
       mOverlap(storedOverlap(settings)),
-      mPool(poolLayout(mSource->header(), settings, *mDevice)) {
+      mBudgetPool(budgetPoolLayout(mSource->header(), settings, *mDevice)),
+      mPool(mBudgetPool.withSlots(0)) {
   mDevice->allocatePool(mPool.layout());
   mStreamer = std::make_unique<Streamer>(mSource, streamerOptions(mSource->header(), settings, mReach));
 }
@@ -199,6 +201,14 @@ RenderStats FrameRenderer::trace(int frame, const Camera& camera, int direction)
   return mActive->stats;
 }
 
+bool FrameRenderer::growPool(std::uint64_t wanted) {
+  const std::uint32_t slots = mPool.layout().slots;
+  if (wanted <= slots || slots == mBudgetPool.slots) return false;
+  mPool = BrickPool(mBudgetPool.withSlots(std::max(wanted, 2 * std::uint64_t(slots))));
+  mDevice->allocatePool(mPool.layout());
+  return true;
+}
+
 void FrameRenderer::begin(int frame, const Camera& camera, int direction) {
   validate(camera, "camera");
   if (!mSource->hasFrame(frame)) throw InputError(mSource->name() + ": no frame " + std::to_string(frame));
@@ -208,12 +218,14 @@ void FrameRenderer::begin(int frame, const Camera& camera, int direction) {
   a.index = mSource->frame(frame);
   const StoreHeader& header = mSource->header();
   a.stats.frameBricks = a.index->bricks.size();
-  a.stats.poolBytes = mPool.layout().bytes();
   a.eyeInBricks = (camera.eye - header.origin) / (header.cellSize * header.brickSize);
   mStreamer->setFrame(frame, direction);
   mStreamer->setEye(a.eyeInBricks);
   a.failedBefore = mStreamer->stats().failed;
   a.pages = pageTable(*a.index);
+  const std::size_t frameResident = std::ranges::count_if(a.pages, [](std::uint32_t p) { return p != kNotResident; });
+  if (growPool(mPool.resident() + (a.index->bricks.size() - frameResident))) a.pages = pageTable(*a.index);
+  a.stats.poolBytes = mPool.layout().bytes();
   mDevice->setOctree(a.index->octree.nodes);
   mDevice->setPageTable(a.pages);
   mDevice->beginImage(mSettings.width, mSettings.height);

@@ -34,7 +34,8 @@ struct RenderSettings {
   std::uint32_t height = 720;
   float radius = 1.0f;   ///< sphere radius in cells
   float jitter = 0.25f;  ///< largest jitter offset in cells (§3.2.2); 0 turns jitter off
-  std::uint64_t gpuBudgetBytes = std::uint64_t(1) << 30;  ///< brick pool on the device
+  /// The most the brick pool on the device may take; it takes what the frames rendered fill.
+  std::uint64_t gpuBudgetBytes = std::uint64_t(1) << 30;
   std::uint64_t cpuCacheBytes = std::uint64_t(2) << 30;   ///< converted bricks, all frames
   unsigned threads = 0;                                   ///< conversion workers; 0: all cores
   int maxPasses = 1000;
@@ -121,6 +122,8 @@ class FrameRenderer {
   RaycastDevice& device() { return *mDevice; }
   const RenderSettings& settings() const { return mSettings; }
   const Streamer& streamer() const { return *mStreamer; }
+  /// The pool as it is now: grown to what the frames rendered so far fill, within the budget.
+  const PoolLayout& poolLayout() const { return mPool.layout(); }
   /// World box of the occupied cells of frames [first, last] (empty box when they hold no
   /// brick). Cell-exact from the bricks on the outer layers, or brick-exact when more than a
   /// few thousand bricks form them across the range.
@@ -137,6 +140,9 @@ class FrameRenderer {
   /// Runs passes of the active frame: waiting for every requested brick (trace()), or until
   /// `budgetMs` has passed or nothing new is ready (advance()).
   void runPasses(bool wait, double budgetMs, bool* changed);
+  /// Reallocates the pool for `wanted` slots (twice its slots at least, the budget's at most)
+  /// when it has fewer and the budget allows more; the bricks it held are gone. Whether it did.
+  bool growPool(std::uint64_t wanted);
   /// Places and uploads `bricks` of the active frame nearest to the eye first, then classifies
   /// their foam.
   void upload(std::vector<std::shared_ptr<const ConvertedBrick>> bricks);
@@ -146,6 +152,10 @@ class FrameRenderer {
   RenderSettings mSettings;
   std::uint32_t mReach = 0;
   std::uint32_t mOverlap = 0;
+  /// The pool the budget allows (RenderSettings::gpuBudgetBytes). The pool begins at 3 slots and
+  /// grows towards it as frames need (growPool): a store smaller than the budget takes only what
+  /// its frames fill.
+  PoolLayout mBudgetPool;
   BrickPool mPool;
   std::unique_ptr<Streamer> mStreamer;
   std::uint64_t mBatch = 0;

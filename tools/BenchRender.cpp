@@ -333,7 +333,7 @@ void addBenchRenderCommand(CLI::App& bench) {
   cmd->add_option("--device", args->device, "auto, gpu, cpu or cpu-reference")
       ->check(CLI::IsMember({"auto", "gpu", "cpu", "cpu-reference"}))
       ->capture_default_str();
-  cmd->add_option("--gpu-mem", args->gpuMem, "Brick pool budget")->capture_default_str();
+  cmd->add_option("--gpu-mem", args->gpuMem, "The most the brick pool may take")->capture_default_str();
   cmd->add_flag("--no-vdb-tool", args->skipVdbTool, "Skip the vdb_tool comparison");
   cmd->add_option("--peer", args->peer,
                   "Also render the same particles with this peer, in the same run: embree (Embree 3 sphere points, "

@@ -145,7 +145,7 @@ void addRenderLookOptions(CLI::App& command, RenderLookArgs& a) {
   cmd->add_option("--bubbles", args->bubbles,
                   "Stores with particle kinds: hide (the bubbles inside the liquid) or show (as particles)")
       ->capture_default_str();
-  cmd->add_option("--gpu-mem", args->gpuMem, "Brick pool budget on the device")->capture_default_str();
+  cmd->add_option("--gpu-mem", args->gpuMem, "The most the brick pool on the device may take")->capture_default_str();
   cmd->add_option("--cpu-mem", args->cpuMem, "Converted-brick cache in CPU memory")->capture_default_str();
   cmd->add_option("--device", args->device, "auto: OpenGL through EGL on a hardware GPU, else the CPU; gpu; cpu; cpu-reference (the exact, slower CPU ray-caster)")
       ->check(CLI::IsMember({"auto", "gpu", "cpu", "cpu-reference"}))

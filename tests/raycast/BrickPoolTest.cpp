@@ -24,6 +24,30 @@ TEST(BrickPool, LayoutFitsTheBudgetAndRefusesATinyOne) {
   EXPECT_THROW(PoolLayout::forBudget(64, 2, true, 100000), InputError);
 }
 
+TEST(BrickPool, LayoutCutToTheSlotsWantedGivesItsRingAllTheirCells) {
+  const PoolLayout budget = PoolLayout::forBudget(64, 2, true, 256ull << 20);
+  const PoolLayout cut = budget.withSlots(10);
+  EXPECT_EQ(cut.slots, 10u);
+  EXPECT_EQ(cut.subBricksPerSlot, budget.subBricksPerSlot);
+  EXPECT_EQ(cut.attributeCapacity, 10 * cut.storedCellsPerSlot());  // every cell of every slot
+  EXPECT_LT(cut.bytes(), budget.bytes() / 10);
+  EXPECT_EQ(budget.withSlots(0).slots, 3u);  // never below the minimum
+  EXPECT_EQ(budget.withSlots(budget.slots).bytes(), budget.bytes());
+  EXPECT_EQ(budget.withSlots(budget.slots + 5).slots, budget.slots);
+  EXPECT_EQ(PoolLayout::forBudget(64, 2, false, 256ull << 20).withSlots(10).attributeCapacity, 0u);
+}
+
+TEST(BrickPool, LayoutCutNearTheBudgetKeepsItsRingWithinIt) {
+  // 35% of the cells per slot fit the budget, not all of them: the cut ring takes what the
+  // slots it dropped leave, and the pool stays within the budget's.
+  const PoolLayout budget = PoolLayout::forBudget(64, 2, true, 64ull << 20);
+  const PoolLayout cut = budget.withSlots(budget.slots - 1);
+  EXPECT_LT(cut.attributeCapacity, std::uint64_t(cut.slots) * cut.storedCellsPerSlot());
+  EXPECT_GT(cut.attributeCapacity, budget.attributeCapacity);
+  EXPECT_LE(cut.bytes(), budget.bytes());
+  EXPECT_EQ(cut.attributeCapacity % 2, 0u);
+}
+
 TEST(BrickPool, EvictsOldestFirstAndReusesItsSlot) {
   BrickPool pool(smallLayout(3, 0));
   std::vector<BrickKey> evicted;
