@@ -40,6 +40,31 @@ bool sameHits(const RenderResult& a, const RenderResult& b) {
          std::memcmp(a.hits.data(), b.hits.data(), a.hits.size() * sizeof(RayHit)) == 0;
 }
 
+/// Each frame rendered alone, by a fresh renderer: what every render of it must equal.
+std::vector<RenderResult> aloneImages(const WaveTank& tank, const Camera& camera) {
+  std::vector<RenderResult> alone;
+  for (int f = 0; f < kFrames; ++f) alone.push_back(tank.renderer()->render(f, camera));
+  return alone;
+}
+
+/// Renders every frame `rounds` times in order: each converges to its image alone, the pool never
+/// shrinks, and `check` sees each result. The pool's slots at the end.
+template <class Check>
+std::uint32_t renderRounds(FrameRenderer& renderer, const Camera& camera, int rounds,
+                           const std::vector<RenderResult>& alone, Check&& check) {
+  std::uint32_t slots = 0;
+  for (int round = 0; round < rounds; ++round)
+    for (int f = 0; f < kFrames; ++f) {
+      const RenderResult result = renderer.render(f, camera);
+      EXPECT_TRUE(result.stats.converged);
+      EXPECT_TRUE(sameHits(result, alone[std::size_t(f)])) << "round " << round << ", frame " << f;
+      EXPECT_GE(renderer.poolLayout().slots, slots) << "a pool never shrinks";
+      slots = renderer.poolLayout().slots;
+      check(f, result);
+    }
+  return slots;
+}
+
 TEST(FrameRendererPool, TakesWhatAFrameFillsAndKeepsItWarm) {
   const WaveTank tank;
   const Camera camera = tank.camera();
@@ -64,20 +89,9 @@ TEST(FrameRendererPool, TakesWhatAFrameFillsAndKeepsItWarm) {
 TEST(FrameRendererPool, GrowsForMoreFramesWithTheSameImages) {
   const WaveTank tank;
   const Camera camera = tank.camera();
-  // Each frame alone, from a fresh renderer: what every later render must equal.
-  std::vector<RenderResult> alone;
-  for (int f = 0; f < kFrames; ++f) alone.push_back(tank.renderer()->render(f, camera));
-
   auto renderer = tank.renderer();
-  std::uint32_t slots = 0;
-  for (int round = 0; round < 3; ++round)
-    for (int f = 0; f < kFrames; ++f) {
-      const RenderResult result = renderer->render(f, camera);
-      ASSERT_TRUE(result.stats.converged);
-      EXPECT_TRUE(sameHits(result, alone[std::size_t(f)])) << "round " << round << ", frame " << f;
-      EXPECT_GE(renderer->poolLayout().slots, slots) << "a pool never shrinks";
-      slots = renderer->poolLayout().slots;
-    }
+  const std::uint32_t slots =
+      renderRounds(*renderer, camera, 3, aloneImages(tank, camera), [](int, const RenderResult&) {});
   // The budget holds every frame: once grown, the pool keeps them all, as a full-budget pool did.
   EXPECT_GE(slots, tank.allBricks());
   EXPECT_LE(slots, 2 * tank.allBricks());
@@ -135,20 +149,16 @@ TEST(FrameRendererPool, StopsAtTheBudget) {
   const std::uint64_t perSlot = least.slotBytes() + least.storedCellsPerSlot() * 35 / 100 * 2;
   tank.settings.gpuBudgetBytes = perSlot * (tank.bricks(0) * 3 / 2);
   auto renderer = tank.renderer();
-  std::uint32_t slots = 0;
-  for (int round = 0; round < 2; ++round)
-    for (int f = 0; f < kFrames; ++f) {
-      const RenderResult result = renderer->render(f, camera);
-      ASSERT_TRUE(result.stats.converged);
-      EXPECT_LE(result.stats.poolBytes, tank.settings.gpuBudgetBytes);
-      slots = renderer->poolLayout().slots;
-      EXPECT_GE(slots, tank.bricks(f));
-    }
+  const std::vector<RenderResult> alone = aloneImages(tank, camera);
+  const std::uint32_t slots = renderRounds(*renderer, camera, 2, alone, [&](int f, const RenderResult& result) {
+    EXPECT_LE(result.stats.poolBytes, tank.settings.gpuBudgetBytes);
+    EXPECT_GE(renderer->poolLayout().slots, tank.bricks(f));
+  });
   EXPECT_LT(slots, tank.allBricks());
   const RenderResult again = renderer->render(0, camera);
   EXPECT_GT(again.stats.bricksUploaded, 0u) << "frame 0 was evicted by the others";
   EXPECT_EQ(renderer->poolLayout().slots, slots);
-  EXPECT_TRUE(sameHits(again, tank.renderer()->render(0, camera)));
+  EXPECT_TRUE(sameHits(again, alone[0]));
 }
 
 }  // namespace
