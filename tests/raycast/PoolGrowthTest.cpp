@@ -3,41 +3,21 @@
 // stops at the budget's pool. Growing drops the bricks it held; the images do not change.
 #include <gtest/gtest.h>
 
-#include <cstring>
-#include <map>
-#include <set>
-
-#include "RaycastScenes.h"
+#include "PoolGrowthScenes.h"
 #include "raycast/CpuRaycaster.h"
-#include "streaming/SyntheticBrickSource.h"
 
 namespace flipscope {
 namespace {
 
-constexpr int kFrames = 4;
+using testing::kFrames;
+using testing::sameHits;
+using testing::WaveTank;
 
-struct WaveTank {
-  std::shared_ptr<SyntheticBrickSource> source =
-      std::make_shared<SyntheticBrickSource>(32, glm::uvec3(4, 4, 2), kFrames, 0.3);
-  RenderSettings settings = testing::smallSettings();
-
-  std::unique_ptr<FrameRenderer> renderer() const {
-    return std::make_unique<FrameRenderer>(source, std::make_unique<CpuRaycaster>(), settings);
-  }
-  Camera camera() const {
-    return frameOnBox(renderer()->occupiedBounds(0, kFrames - 1), double(settings.width) / settings.height, {0, 0, 1});
-  }
-  std::size_t bricks(int frame) const { return source->frame(frame)->bricks.size(); }
-  std::size_t allBricks() const {
-    std::size_t n = 0;
-    for (int f = 0; f < kFrames; ++f) n += bricks(f);
-    return n;
-  }
-};
-
-bool sameHits(const RenderResult& a, const RenderResult& b) {
-  return a.hits.size() == b.hits.size() &&
-         std::memcmp(a.hits.data(), b.hits.data(), a.hits.size() * sizeof(RayHit)) == 0;
+/// The wave tank on the CPU reference ray-caster.
+WaveTank cpuTank() {
+  WaveTank tank;
+  tank.device = [] { return std::make_unique<CpuRaycaster>(); };
+  return tank;
 }
 
 /// Each frame rendered alone, by a fresh renderer: what every render of it must equal.
@@ -66,7 +46,7 @@ std::uint32_t renderRounds(FrameRenderer& renderer, const Camera& camera, int ro
 }
 
 TEST(FrameRendererPool, TakesWhatAFrameFillsAndKeepsItWarm) {
-  const WaveTank tank;
+  const WaveTank tank = cpuTank();
   const Camera camera = tank.camera();
   auto renderer = tank.renderer();
   EXPECT_EQ(renderer->poolLayout().slots, 3u);  // nothing rendered yet
@@ -87,7 +67,7 @@ TEST(FrameRendererPool, TakesWhatAFrameFillsAndKeepsItWarm) {
 }
 
 TEST(FrameRendererPool, GrowsForMoreFramesWithTheSameImages) {
-  const WaveTank tank;
+  const WaveTank tank = cpuTank();
   const Camera camera = tank.camera();
   auto renderer = tank.renderer();
   const std::uint32_t slots =
@@ -103,45 +83,11 @@ TEST(FrameRendererPool, GrowsForMoreFramesWithTheSameImages) {
 }
 
 TEST(FrameRendererPool, GrowsWhileTheFrameBegunHoldsBricks) {
-  // Narrow views upload a few bricks of a frame; a later wide view of it finds some resident
-  // while the pool must grow for the rest. The pool it grows into holds none of them.
-  const WaveTank tank;
-  const Camera wide = tank.camera();
-  std::vector<Camera> cameras{wide};
-  for (double side : {-1.0, 1.0}) {
-    Camera narrow = wide;
-    narrow.fovYDegrees = 8;
-    narrow.target += side * 0.3 * wide.right() * glm::distance(wide.eye, wide.target) * 0.2;
-    cameras.push_back(narrow);
-  }
-  std::map<std::pair<int, std::size_t>, RenderResult> alone;
-  for (int f = 0; f < kFrames; ++f)
-    for (std::size_t c = 0; c < cameras.size(); ++c) alone[{f, c}] = tank.renderer()->render(f, cameras[c]);
-
-  auto renderer = tank.renderer();
-  const std::vector<std::pair<int, std::size_t>> views{{0, 1}, {1, 1}, {0, 2}, {2, 0}, {0, 0}, {3, 1},
-                                                       {1, 0}, {3, 0}, {2, 2}, {0, 0}, {1, 2}, {3, 2}};
-  // Below the budget nothing is evicted (EXPECT below): a frame holds bricks in the pool exactly
-  // when it was rendered since the pool last grew.
-  std::set<int> sinceGrowth;
-  std::uint64_t grownWithResidents = 0;
-  for (const auto& [f, c] : views) {
-    const std::uint32_t slotsBefore = renderer->poolLayout().slots;
-    const RenderResult result = renderer->render(f, cameras[c]);
-    ASSERT_TRUE(result.stats.converged);
-    EXPECT_EQ(result.stats.bricksEvicted, 0u);
-    EXPECT_TRUE(sameHits(result, alone[{f, c}])) << "frame " << f << ", camera " << c;
-    if (renderer->poolLayout().slots > slotsBefore) {
-      grownWithResidents += sinceGrowth.contains(f);
-      sinceGrowth.clear();
-    }
-    sinceGrowth.insert(f);
-  }
-  EXPECT_GT(grownWithResidents, 0u) << "no view grew the pool while its frame held bricks";
+  testing::expectGrownPoolViewsEqualTheirImagesAlone(cpuTank());
 }
 
 TEST(FrameRendererPool, StopsAtTheBudget) {
-  WaveTank tank;
+  WaveTank tank = cpuTank();
   const Camera camera = tank.camera();
   const PoolLayout least = tank.renderer()->poolLayout();
   // Room for a frame and a half, with the ring's 35% (PoolLayout::forBudget): growth stops there
