@@ -51,7 +51,7 @@ PoolLayout PoolLayout::withSlots(std::uint64_t wanted) const {
   layout.slots = std::uint32_t(wanted);
   if (attributes) {
     const std::uint64_t freed = (bytes() - wanted * slotBytes()) / 2;
-    layout.attributeCapacity = std::min(freed, wanted * storedCellsPerSlot()) & ~std::uint64_t(1);
+    layout.attributeCapacity = std::min({freed, wanted * storedCellsPerSlot(), attributeCapacity}) & ~std::uint64_t(1);
   }
   return layout;
 }

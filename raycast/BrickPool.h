@@ -52,9 +52,9 @@ struct PoolLayout {
                               std::uint64_t budgetBytes, bool foam = false, bool marchTables = false,
                               std::uint32_t reach = 0);
   /// This (budget's) pool cut to `wanted` slots (at least 3) when it has more: bricks no frame
-  /// asked for cost no memory. The ring then holds every stored cell of every slot, within the
-  /// bytes the slots left free; the pool is never larger than this one. `*this` when `wanted`
-  /// is not below its slots.
+  /// asked for cost no memory. The ring then holds every stored cell of every slot, up to this
+  /// pool's ring (which the device's buffer limit was checked against), so it is never larger
+  /// than this one's, and any one brick still fits. `*this` when `wanted` is not below its slots.
   PoolLayout withSlots(std::uint64_t wanted) const;
 };
 

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <memory>
 #include <thread>
+#include <type_traits>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -30,29 +31,24 @@ std::string CpuRaycaster::name() const {
 }
 
 void CpuRaycaster::allocatePool(const PoolLayout& layout) {
+  mPool.layout = PoolLayout{};  // no slots until every array is made (RaycastDevice's contract)
+  const auto fresh = [](auto& array, std::size_t size) {
+    std::remove_cvref_t<decltype(array)>().swap(array);  // let the old one go first
+    array.resize(size);
+  };
+  const std::size_t slots = layout.slots;
+  fresh(mPool.subBricks, slots * layout.subBricksPerSlot);
+  fresh(mPool.mipWords, slots * layout.mipWordsPerSlot);
+  fresh(mPool.attributeBases, layout.attributes ? slots * layout.subBricksPerSlot : 0);
+  fresh(mPool.attributes, layout.attributeCapacity);
+  fresh(mPool.foamBits, layout.foam ? slots * layout.subBricksPerSlot : 0);
+  fresh(mPool.foamOccupancy, layout.foam ? slots * layout.foamOccupancyWords() : 0);
+  fresh(mPool.halfCounts, layout.marchTables ? slots * layout.subBricksPerSlot * 4 : 0);
+  fresh(mPool.nearSpheres, layout.marchTables ? slots * nearSphereMaskWords(layout.brickSize) : 0);
+  fresh(mPool.clearDistances, layout.marchTables ? slots * layout.subBricksPerSlot : 0);
+  fresh(mPool.nearDistances, layout.marchTables ? slots * nearSphereGroupCount(layout.brickSize) : 0);
+  fresh(mPool.setBounds, layout.marchTables ? slots : 0);
   mPool.layout = layout;
-  mPool.subBricks.clear();
-  mPool.subBricks.resize(std::size_t(layout.slots) * layout.subBricksPerSlot);
-  mPool.mipWords.clear();
-  mPool.mipWords.resize(std::size_t(layout.slots) * layout.mipWordsPerSlot);
-  mPool.attributeBases.clear();
-  mPool.attributeBases.resize(layout.attributes ? std::size_t(layout.slots) * layout.subBricksPerSlot : 0);
-  mPool.attributes.clear();
-  mPool.attributes.resize(layout.attributeCapacity);
-  mPool.foamBits.clear();
-  mPool.foamBits.resize(layout.foam ? std::size_t(layout.slots) * layout.subBricksPerSlot : 0);
-  mPool.foamOccupancy.clear();
-  mPool.foamOccupancy.resize(layout.foam ? std::size_t(layout.slots) * layout.foamOccupancyWords() : 0);
-  mPool.halfCounts.clear();
-  mPool.halfCounts.resize(layout.marchTables ? std::size_t(layout.slots) * layout.subBricksPerSlot * 4 : 0);
-  mPool.nearSpheres.clear();
-  mPool.nearSpheres.resize(layout.marchTables ? std::size_t(layout.slots) * nearSphereMaskWords(layout.brickSize) : 0);
-  mPool.clearDistances.clear();
-  mPool.clearDistances.resize(layout.marchTables ? std::size_t(layout.slots) * layout.subBricksPerSlot : 0);
-  mPool.nearDistances.clear();
-  mPool.nearDistances.resize(layout.marchTables ? std::size_t(layout.slots) * nearSphereGroupCount(layout.brickSize) : 0);
-  mPool.setBounds.clear();
-  mPool.setBounds.resize(layout.marchTables ? layout.slots : 0);
 }
 
 void CpuRaycaster::setOctree(std::span<const OctreeNode> nodes) {

@@ -204,6 +204,10 @@ RenderStats FrameRenderer::trace(int frame, const Camera& camera, int direction)
 bool FrameRenderer::growPool(std::uint64_t wanted) {
   const std::uint32_t slots = mPool.layout().slots;
   if (wanted <= slots || slots == mBudgetPool.slots) return false;
+  // Nothing refers to the old pool once the device reallocates: not the frame begun before (its
+  // page table), not the BrickPool. A device records its new layout last, so where allocating
+  // throws, the empty BrickPool's first upload is refused rather than written out of bounds.
+  mActive.reset();
   mPool = BrickPool(mBudgetPool.withSlots(std::max(wanted, 2 * std::uint64_t(slots))));
   mDevice->allocatePool(mPool.layout());
   return true;

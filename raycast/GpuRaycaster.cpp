@@ -69,13 +69,16 @@ std::string GpuRaycaster::name() const {
 }
 
 void GpuRaycaster::allocatePool(const PoolLayout& layout) {
-  mLayout = layout;
+  mLayout = PoolLayout{};  // no slots until every buffer is made (RaycastDevice's contract)
+  for (gl::Buffer* buffer : {&mSubBricks, &mMips, &mAttributeBases, &mAttributes, &mFoam, &mFoamOccupancy})
+    *buffer = gl::Buffer();  // let the old ones go first
   mSubBricks = makeBuffer(std::uint64_t(layout.slots) * layout.subBricksPerSlot * 16);
   mMips = makeBuffer(std::uint64_t(layout.slots) * layout.mipWordsPerSlot * 4);
   mAttributeBases = makeBuffer(layout.attributes ? std::uint64_t(layout.slots) * layout.subBricksPerSlot * 4 : 0);
   mAttributes = makeBuffer(layout.attributeCapacity * 2);
   mFoam = makeBuffer(layout.foam ? std::uint64_t(layout.slots) * layout.subBricksPerSlot * 16 : 0);
   mFoamOccupancy = makeBuffer(layout.foam ? std::uint64_t(layout.slots) * layout.foamOccupancyWords() * 4 : 0);
+  mLayout = layout;
 }
 
 void GpuRaycaster::setOctree(std::span<const OctreeNode> nodes) {

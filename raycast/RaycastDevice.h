@@ -27,7 +27,10 @@ class RaycastDevice {
   /// Whether the pool keeps the fast CPU device's tables (PoolLayout::marchTables), which the
   /// budget then pays for.
   virtual bool keepsMarchTables() const { return false; }
-  /// Allocates the pool (every slot empty). Throws when the device cannot hold it.
+  /// Allocates the pool (every slot empty), replacing any earlier one (FrameRenderer grows it):
+  /// the earlier buffers go before the new ones are made, and the layout is recorded last, so
+  /// one that throws leaves a pool of no slots, whose uploads are refused. Throws when the device
+  /// cannot hold it.
   virtual void allocatePool(const PoolLayout& layout) = 0;
   /// The current frame's presence octree, and its page table: one slot (or kNotResident) per
   /// brick of the frame's brick table.

@@ -37,15 +37,20 @@ TEST(BrickPool, LayoutCutToTheSlotsWantedGivesItsRingAllTheirCells) {
   EXPECT_EQ(PoolLayout::forBudget(64, 2, false, 256ull << 20).withSlots(10).attributeCapacity, 0u);
 }
 
-TEST(BrickPool, LayoutCutNearTheBudgetKeepsItsRingWithinIt) {
-  // 35% of the cells per slot fit the budget, not all of them: the cut ring takes what the
-  // slots it dropped leave, and the pool stays within the budget's.
+TEST(BrickPool, LayoutCutNearTheBudgetKeepsTheBudgetsRing) {
+  // The budget's ring holds 35% of the cells of its slots. Cut to fewer slots than hold all
+  // their cells in that ring, the ring stays the budget's, not what the dropped slots freed:
+  // the device's buffer limit was checked against the budget's ring.
   const PoolLayout budget = PoolLayout::forBudget(64, 2, true, 64ull << 20);
-  const PoolLayout cut = budget.withSlots(budget.slots - 1);
-  EXPECT_LT(cut.attributeCapacity, std::uint64_t(cut.slots) * cut.storedCellsPerSlot());
-  EXPECT_GT(cut.attributeCapacity, budget.attributeCapacity);
-  EXPECT_LE(cut.bytes(), budget.bytes());
-  EXPECT_EQ(cut.attributeCapacity % 2, 0u);
+  for (std::uint64_t slots : {budget.slots - 1, budget.slots / 2, budget.slots * 2 / 5}) {
+    const PoolLayout cut = budget.withSlots(slots);
+    EXPECT_LT(cut.attributeCapacity, std::uint64_t(cut.slots) * cut.storedCellsPerSlot()) << slots;
+    EXPECT_EQ(cut.attributeCapacity, budget.attributeCapacity) << slots;
+    EXPECT_LT(cut.bytes(), budget.bytes()) << slots;
+  }
+  const PoolLayout few = budget.withSlots(budget.slots / 4);  // all their cells fit the budget's ring
+  EXPECT_EQ(few.attributeCapacity, few.slots * few.storedCellsPerSlot());
+  EXPECT_LT(few.attributeCapacity, budget.attributeCapacity);
 }
 
 TEST(BrickPool, EvictsOldestFirstAndReusesItsSlot) {

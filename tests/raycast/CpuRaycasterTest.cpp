@@ -202,6 +202,21 @@ TEST(FrameRenderer, RejectsMissingFramesAndBadSettings) {
   EXPECT_THROW(cpuRenderer(store, settings), InputError);
 }
 
+TEST(CpuRaycaster, APoolThatCannotBeMadeLeavesNoSlots) {
+  // RaycastDevice::allocatePool: the layout is recorded last, so a device whose new pool could
+  // not be made refuses every upload (slot < slots) instead of writing past its arrays.
+  CpuRaycaster device;
+  const PoolLayout layout = PoolLayout::forBudget(32, 1, true, 64ull << 20);
+  device.allocatePool(layout);
+  EXPECT_EQ(device.pool().layout.slots, layout.slots);
+  EXPECT_EQ(device.pool().attributes.size(), layout.attributeCapacity);
+  PoolLayout impossible = layout;
+  impossible.slots *= 2;
+  impossible.attributeCapacity = std::uint64_t(1) << 62;  // beyond what a vector can hold
+  EXPECT_ANY_THROW(device.allocatePool(impossible));
+  EXPECT_EQ(device.pool().layout.slots, 0u);
+}
+
 TEST(FrameRenderer, ConvergesOverASyntheticSource) {
   // No store: the wave tank's bricks, frame indices and domain come from the source itself.
   auto source = std::make_shared<SyntheticBrickSource>(32, glm::uvec3(4, 4, 2), 2, 0.3);
