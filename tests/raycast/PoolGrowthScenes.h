@@ -51,7 +51,7 @@ inline void expectGrownPoolViewsEqualTheirImagesAlone(const WaveTank& tank) {
   for (double side : {-1.0, 1.0}) {
     Camera narrow = wide;
     narrow.fovYDegrees = 8;
-    narrow.target += side * 0.3 * wide.right() * glm::distance(wide.eye, wide.target) * 0.2;
+    narrow.target += side * 0.06 * glm::distance(wide.eye, wide.target) * wide.right();  // left, right
     cameras.push_back(narrow);
   }
   std::map<std::pair<int, std::size_t>, RenderResult> alone;
