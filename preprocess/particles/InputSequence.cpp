@@ -6,9 +6,12 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <map>
 #include <set>
 
 #include "core/Error.h"
+#include "preprocess/particles/ParticleFormatRegistry.h"
+#include "preprocess/particles/ParticleFormats.h"
 
 namespace flipscope {
 namespace {
@@ -84,12 +87,75 @@ std::vector<int> discoverFrames(const std::string& input, const FramePattern& pa
   return {frames.begin(), frames.end()};
 }
 
+/// Whether `name` ends with a particle format's extension: the extension's length, else 0.
+std::size_t particleExtensionLength(const std::string& name) {
+  const std::string lower = detail::asciiLower(name);
+  std::size_t longest = 0;
+  for (const ParticleFormat& format : particleFormats())
+    for (std::string_view extension : format.extensions)
+      if (lower.size() > extension.size() && lower.ends_with(extension)) longest = std::max(longest, extension.size());
+  return longest;
+}
+
+/// The numbered particle files in `dir` and in its sub-directories one level down, as input
+/// patterns (the number's last run of digits as '#', one per digit of the shortest) with how
+/// many files each has, the most first, at most `limit`: "'dir/data/fluid_data_####.vdb' (30
+/// files)". For the message of a directory given as an input.
+std::vector<std::string> numberedSequencesIn(const std::filesystem::path& dir, std::size_t limit) {
+  struct Group {
+    std::size_t files = 0, digits = 0;
+  };
+  std::map<std::pair<std::filesystem::path, std::string>, Group> groups;  // (directory, name with '#')
+  constexpr std::size_t kMaxEntries = 100000;                             // a listing that large is not worth the wait
+  std::size_t entries = 0;
+  // Lists `folder`; its sub-directories go to `subfolders` where given.
+  const auto scan = [&](const std::filesystem::path& folder, std::vector<std::filesystem::path>* subfolders) {
+    std::error_code ec;
+    for (std::filesystem::directory_iterator it(folder, ec), end; !ec && it != end && entries < kMaxEntries;
+         it.increment(ec), ++entries) {
+      const std::string name = it->path().filename().string();
+      std::error_code typeError;
+      if (subfolders && it->is_directory(typeError)) {
+        subfolders->push_back(it->path());
+        continue;
+      }
+      const std::size_t stem = name.size() - particleExtensionLength(name);
+      if (stem == name.size()) continue;
+      const std::size_t last = name.find_last_of("0123456789", stem - 1);
+      if (last == std::string::npos) continue;
+      const std::size_t first = name.find_last_not_of("0123456789", last) + 1;  // npos + 1 = 0
+      Group& group = groups[{folder, name.substr(0, first) + '#' + name.substr(last + 1)}];
+      const std::size_t digits = last + 1 - first;
+      group.digits = group.files++ ? std::min(group.digits, digits) : digits;
+    }
+  };
+  std::vector<std::filesystem::path> subfolders;
+  scan(dir, &subfolders);
+  for (const std::filesystem::path& folder : subfolders) scan(folder, nullptr);
+  std::vector<std::pair<std::size_t, std::string>> found;
+  for (const auto& [key, group] : groups) {
+    std::string name = key.second;
+    name.replace(name.find('#'), 1, std::string(group.digits, '#'));
+    found.emplace_back(group.files, "'" + (key.first / name).string() + "' (" + std::to_string(group.files) +
+                                        (group.files == 1 ? " file)" : " files)"));
+  }
+  std::stable_sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::vector<std::string> result;
+  for (std::size_t i = 0; i < found.size() && i < limit; ++i) result.push_back(found[i].second);
+  return result;
+}
+
 void expectFile(const std::filesystem::path& path, const std::string& context) {
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
   if (!std::filesystem::exists(status)) throw FileError(path, "no such file (" + context + ")");
-  if (std::filesystem::is_directory(status))
-    throw FileError(path, "is a directory, expected a particle file (" + context + ")");
+  if (std::filesystem::is_directory(status)) {
+    std::string holds;
+    for (const std::string& sequence : numberedSequencesIn(path, 6)) holds += (holds.empty() ? "" : ", ") + sequence;
+    throw FileError(path, "is a directory, expected a particle file or a frame pattern (" + context + "); " +
+                              (holds.empty() ? "it holds no numbered particle files"
+                                             : "it holds the numbered particle files " + holds));
+  }
   if (!std::filesystem::is_regular_file(status))
     throw FileError(path, "is not a regular file (a device, pipe or socket), expected a particle file (" + context + ")");
 }

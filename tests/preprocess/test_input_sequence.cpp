@@ -75,6 +75,33 @@ TEST(InputSequence, DiscoversFramesInTheDirectory) {
                            {"no file matches input pattern", "none_####.vdb"});
 }
 
+TEST(InputSequence, ADirectoryGivenAsInputNamesTheSequencesItHolds) {
+  TempDir dir("seq-folder");
+  std::filesystem::create_directories(dir / "cache" / "data");
+  std::filesystem::create_directories(dir / "cache" / "particles");
+  for (int f : {1, 2, 10}) touch(dir / "cache" / "data" / substituteFrame("fluid_data_####.vdb", f));
+  touch(dir / "cache" / "particles" / "fluid_particles_0001.vdb");
+  touch(dir / "cache" / "splash.1.bgeo.sc");
+  touch(dir / "cache" / "splash.12.bgeo.sc");  // unpadded: one '#'
+  touch(dir / "cache" / "notes_01.txt");       // not a particle file
+  touch(dir / "cache" / "fluid.vdb");          // not numbered
+  const std::string cache = (dir / "cache").string();
+  testing::expectFileError(
+      [&] { expandInputs({cache}, std::nullopt); },
+      {"cache: is a directory", "or a frame pattern",
+       "'" + cache + "/data/fluid_data_####.vdb' (3 files), '" + cache + "/splash.#.bgeo.sc' (2 files), '" + cache +
+           "/particles/fluid_particles_####.vdb' (1 file)"});
+  try {
+    expandInputs({cache}, std::nullopt);
+  } catch (const FileError& e) {
+    EXPECT_EQ(std::string(e.what()).find("notes"), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find("fluid.vdb"), std::string::npos) << e.what();
+  }
+  std::filesystem::create_directories(dir / "empty");
+  testing::expectFileError([&] { expandInputs({(dir / "empty").string()}, std::nullopt); },
+                           {"empty: is a directory", "it holds no numbered particle files"});
+}
+
 TEST(InputSequence, FrameRangeAndTwoInputsPerFrame) {
   TempDir dir("seq-range");
   for (int f = 1; f <= 5; ++f) {
