@@ -31,7 +31,7 @@ namespace {
 
 constexpr std::size_t kChunkParticles = 1 << 16;
 constexpr std::size_t kNeighbours = kSpacingNeighbour;
-/// The cells of KthNeighbours: half the radius, at most this many (4 MiB of bits; coarser cells
+/// The cells of KthNeighbours: the radius, at most this many (4 MiB of bits; coarser cells
 /// beyond).
 constexpr double kMaxSearchCells = double(std::size_t(1) << 25);
 /// ... and at most this many along an axis (a bound on the rounding of cellsOf).
@@ -165,25 +165,20 @@ std::optional<Sample> sampleByNumber(ParticleSource& source, std::size_t size) {
 }
 
 /// The k-th neighbour distance of every query among the candidates given to add(), searched as
-/// far as `radius`: a query whose k-th neighbour is farther keeps +inf. A grid of cells of half
-/// the radius or of the radius (coarser where that would exceed kMaxSearchCells, or
-/// kMaxAxisCells along an axis) covers the queries' bounds grown by the radius, and each cell
-/// lists the queries within reach of some point of it. A candidate looks up its own cell only
-/// (found in floats, four at a time): a bit turns it away when the list is empty (most
-/// candidates lie far from every query), else it measures its distance to each listed query.
-/// The reach is the radius plus a margin for the rounding of a candidate's cell, so the lists
-/// are a superset and the search is exact. A candidate with the id of a query is that query
-/// itself and skipped.
+/// far as `radius`: a query whose k-th neighbour is farther keeps +inf. A grid of cells of the
+/// radius (coarser where that would exceed kMaxSearchCells, or kMaxAxisCells along an axis) covers the queries' bounds
+/// grown by the radius, and each cell lists the queries within reach of some point of it. A candidate looks up its own
+/// cell only (found in floats, four at a time): a bit turns it away when the list is empty (most candidates lie far
+/// from every query), else it measures its distance to each listed query. The reach is the radius plus a margin for the
+/// rounding of a candidate's cell, so the lists are a superset and the search is exact. A candidate with the id of a
+/// query is that query itself and skipped.
 class KthNeighbours {
  public:
-  /// `fine`: cells of half the radius, for many candidates per query (a frame against its
-  /// sample): fewer pass the bits and the lists are shorter. Else cells of the radius, for few
-  /// (the sample against itself): the lists are built about four times faster.
-  KthNeighbours(const Sample& queries, double radius, bool fine)
-      : mQueries(queries),
-        mRadius(radius),
-        mCell(fine ? radius / 2 : radius),
-        mHeaps(queries.positions.size() * kNeighbours, kInf) {
+  /// Cells of the radius, not of half of it, for the frame's pass too: there, fewer candidates
+  /// would pass the bits of finer cells, but the lists, eight times as many cells, took longer
+  /// to build than that saved (20 M particle frames, and 100 M, 2026-12-05).
+  KthNeighbours(const Sample& queries, double radius)
+      : mQueries(queries), mRadius(radius), mCell(radius), mHeaps(queries.positions.size() * kNeighbours, kInf) {
     glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
     for (const glm::vec3& q : queries.positions) {
       lo = glm::min(lo, glm::dvec3(q));
@@ -319,27 +314,28 @@ class KthNeighbours {
     std::vector<std::pair<std::size_t, std::uint32_t>> order(n);
     for (std::size_t j = 0; j < n; ++j) order[j] = {cellIndex(glm::dvec3(mQueries.positions[j])), std::uint32_t(j)};
     std::sort(order.begin(), order.end());
-    // Each (cell, query) pair once, then the bits, the rank of each word's first bit, each
-    // list's length, and the lists.
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> near;
-    for (const auto& entry : order) {
-      const std::uint32_t j = entry.second;
-      forEachCellNear(mQueries.positions[j], reach, [&](std::size_t bit) { near.emplace_back(std::uint32_t(bit), j); });
-    }
+    // Three walks over the (cell, query) pairs, each visited afresh (cheaper than keeping them,
+    // millions of pairs of fresh memory): the bits; each list's length; the lists, filled from
+    // their ends (the order within a list is of no account). In between, the rank of each word's
+    // first bit and the lists' ends.
+    const auto forEachPair = [&](auto visit) {
+      for (const auto& entry : order) {
+        const std::uint32_t j = entry.second;
+        forEachCellNear(mQueries.positions[j], reach, [&](std::size_t bit) { visit(bit, j); });
+      }
+    };
     mBits.assign(words, 0);
-    for (const auto& [bit, j] : near) mBits[bit / 64] |= std::uint64_t(1) << (bit % 64);
+    forEachPair([&](std::size_t bit, std::uint32_t) { mBits[bit / 64] |= std::uint64_t(1) << (bit % 64); });
     mWordRank.resize(words + 1);
     mWordRank[0] = 0;
     for (std::size_t w = 0; w < words; ++w) mWordRank[w + 1] = mWordRank[w] + std::uint32_t(std::popcount(mBits[w]));
-    mListStart.assign(std::size_t(mWordRank[words]) + 1, 0);
-    for (auto& [bit, j] : near) {
-      bit = std::uint32_t(listOf(bit, mBits[bit / 64]));  // from here on: the list
-      ++mListStart[bit + 1];
-    }
-    for (std::size_t i = 1; i < mListStart.size(); ++i) mListStart[i] += mListStart[i - 1];
-    mListed.resize(mListStart.back());
-    std::vector<std::uint32_t> next(mListStart.begin(), mListStart.end() - 1);
-    for (const auto& [list, j] : near) mListed[next[list]++] = j;
+    const std::size_t lists = mWordRank[words];
+    mListStart.assign(lists + 1, 0);
+    forEachPair([&](std::size_t bit, std::uint32_t) { ++mListStart[listOf(bit, mBits[bit / 64])]; });
+    for (std::size_t i = 1; i < lists; ++i) mListStart[i] += mListStart[i - 1];  // each list's end
+    mListStart[lists] = lists ? mListStart[lists - 1] : 0;
+    mListed.resize(mListStart[lists]);
+    forEachPair([&](std::size_t bit, std::uint32_t j) { mListed[--mListStart[listOf(bit, mBits[bit / 64])]] = j; });
   }
 
   /// The bit of the cell of p, a point inside [mLo, mHi].
@@ -547,7 +543,7 @@ double medianWithinSample(const Sample& s) {
   }
   // Beyond 2 * longest every query has every other particle (n > k) within the radius.
   for (int attempt = 0; attempt < 64; ++attempt, radius *= 2) {
-    KthNeighbours search(s, std::min(radius, 2 * longest), false);
+    KthNeighbours search(s, std::min(radius, 2 * longest));
     search.add(s.positions, s.ids);
     const double median = search.median();
     if (std::isfinite(median)) return median;
@@ -597,7 +593,7 @@ SpacingEstimate neighbourSpacing(ParticleSource& source, std::size_t sampleSize,
     median = std::numeric_limits<double>::infinity();
     for (int pass = 1; pass < kSpacingMaxPasses && !std::isfinite(median); ++pass, radius *= 2) {
       FiniteTally tally;
-      KthNeighbours search(sample, radius, true);
+      KthNeighbours search(sample, radius);
       if (!addInParallel(source, search, tally, progress)) {
         ParticleChunk chunk;
         std::uint64_t id = 0;
@@ -632,12 +628,11 @@ SpacingEstimate neighbourSpacing(ParticleSource& source, std::size_t sampleSize,
 
 std::vector<double> detail::kthNeighbourDistances(std::span<const glm::vec3> queries,
                                                   std::span<const std::uint64_t> queryIds,
-                                                  std::span<const glm::vec3> candidates, double radius,
-                                                  bool fineCells) {
+                                                  std::span<const glm::vec3> candidates, double radius) {
   Sample sample;
   sample.positions.assign(queries.begin(), queries.end());
   sample.ids.assign(queryIds.begin(), queryIds.end());
-  KthNeighbours search(sample, radius, fineCells);
+  KthNeighbours search(sample, radius);
   search.add(candidates, 0);
   return search.distances();
 }

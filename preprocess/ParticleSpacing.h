@@ -25,9 +25,9 @@
 // Cost of the neighbour estimate: one read of the source when it has at most kSpacingSample
 // particles or seeks to a particle (raw, binary PLY: the sample costs kSpacingSample small
 // reads, asked of the disk all at once), else two (rarely more); memory O(kSpacingSample) plus one chunk of particles,
-// plus at most about 100 MiB, whatever the frame's size, for the search's cells near the sample (30 MiB on the frames
-// measured): 4 MiB of bits and, per cell within the search radius of a sampled particle (at most 216 each), the list of
-// those particles. The source is rewound afterwards.
+// plus at most about 20 MiB, whatever the frame's size, for the search's cells near the sample (about 5 MiB for the
+// 20 M particle synth frame): at most 4 MiB of bits and 2 MiB of their ranks and, per cell within the search radius of
+// a sampled particle (at most 64 each), the list of those particles. The source is rewound afterwards.
 #pragma once
 
 #include <cstddef>
@@ -72,11 +72,9 @@ SpacingEstimate neighbourSpacing(std::span<const glm::vec3> points, std::size_t 
 namespace detail {
 /// The search under the neighbour estimate: for each query, the distance to its
 /// kSpacingNeighbour-th nearest candidate, +inf where that lies beyond `radius`. Candidate i
-/// has id i; a candidate with a query's id is that query itself and does not count. The search
-/// indexes the queries in cells of half the radius (`fineCells`: a frame's pass) or of the
-/// radius (the sample against itself); the result is the same.
+/// has id i; a candidate with a query's id is that query itself and does not count.
 std::vector<double> kthNeighbourDistances(std::span<const glm::vec3> queries, std::span<const std::uint64_t> queryIds,
-                                          std::span<const glm::vec3> candidates, double radius, bool fineCells);
+                                          std::span<const glm::vec3> candidates, double radius);
 }  // namespace detail
 
 }  // namespace flipscope

@@ -102,25 +102,24 @@ TEST(ParticleSpacing, TheSearchFindsTheKthNeighboursOfComparingEveryPair) {
   std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(sorted.size() / 2), sorted.end());
   const double median = std::sqrt(double(sorted[sorted.size() / 2]));
 
-  for (const bool fineCells : {true, false})
-    for (const double radius : {0.4 * median, median, 2.5 * median}) {
-      const std::vector<double> found = detail::kthNeighbourDistances(queries, ids, candidates, radius, fineCells);
-      ASSERT_EQ(found.size(), queries.size());
-      std::size_t within = 0;
-      for (std::size_t q = 0; q < queries.size(); ++q) {
-        const double expected =
-            double(kth2[q]) <= radius * radius ? std::sqrt(double(kth2[q])) : std::numeric_limits<double>::infinity();
-        within += std::isfinite(expected);
-        ASSERT_EQ(found[q], expected) << "query " << q << " at radius " << radius << (fineCells ? ", fine" : "");
-      }
-      EXPECT_GT(within, 0u);
-      EXPECT_LT(within, queries.size()) << "some queries' 12th neighbour lies beyond the radius";
+  for (const double radius : {0.4 * median, median, 2.5 * median}) {
+    const std::vector<double> found = detail::kthNeighbourDistances(queries, ids, candidates, radius);
+    ASSERT_EQ(found.size(), queries.size());
+    std::size_t within = 0;
+    for (std::size_t q = 0; q < queries.size(); ++q) {
+      const double expected =
+          double(kth2[q]) <= radius * radius ? std::sqrt(double(kth2[q])) : std::numeric_limits<double>::infinity();
+      within += std::isfinite(expected);
+      ASSERT_EQ(found[q], expected) << "query " << q << " at radius " << radius;
     }
+    EXPECT_GT(within, 0u);
+    EXPECT_LT(within, queries.size()) << "some queries' 12th neighbour lies beyond the radius";
+  }
 }
 
 TEST(ParticleSpacing, TheSearchFindsNeighboursExactlyAtTheRadiusOnTheFacesOfItsCells) {
-  // One query at (1, 1, 1), radius 0.5: the search's cells (half the radius or the radius, from
-  // the query's bounds grown by the radius) have faces through x = 1.5, y = 1.5 and z = 1.5, so
+  // One query at (1, 1, 1), radius 0.5: the search's cells (of the radius, from the query's
+  // bounds grown by the radius) have faces through x = 1.5, y = 1.5 and z = 1.5, so
   // the candidates at +0.5 on each axis lie on the near faces of cells exactly 0.5 away. Nine
   // candidates nearer make those three the 10th to 12th neighbours: the 12th distance is 0.5
   // when the cells' lists reach the whole radius, +inf when they stop short of it.
@@ -135,9 +134,7 @@ TEST(ParticleSpacing, TheSearchFindsNeighboursExactlyAtTheRadiusOnTheFacesOfItsC
   }
   const std::vector<glm::vec3> queries{q};
   const std::vector<std::uint64_t> ids{candidates.size()};  // no candidate
-  for (const bool fineCells : {true, false})
-    EXPECT_EQ(detail::kthNeighbourDistances(queries, ids, candidates, 0.5, fineCells), std::vector<double>{0.5})
-        << (fineCells ? "cells of half the radius" : "cells of the radius");
+  EXPECT_EQ(detail::kthNeighbourDistances(queries, ids, candidates, 0.5), std::vector<double>{0.5});
 }
 
 TEST(ParticleSpacing, SampledEstimateReadsEveryParticleForNeighbours) {
