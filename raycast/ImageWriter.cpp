@@ -10,9 +10,12 @@
 
 #include <Imath/half.h>
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cctype>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <optional>
 
 #include "core/AtomicFile.h"
@@ -183,11 +186,59 @@ void writeExr(const std::filesystem::path& path, const RenderImage& image) {
   });
 }
 
-std::uint8_t linearToSrgb8(float linear) {
+std::uint8_t linearToSrgb8Formula(float linear) {
   if (!(linear > 0.0f)) return 0;  // also NaN
   if (linear >= 1.0f) return 255;
   const double v = linear <= 0.0031308f ? 12.92 * linear : 1.055 * std::pow(double(linear), 1.0 / 2.4) - 0.055;
   return std::uint8_t(std::lround(v * 255.0));
+}
+
+namespace {
+
+/// linearToSrgb8Formula without its pow (a PNG's three a pixel were a fifth of writing it), to
+/// the same code for every float: the formula rises with its input, so the code of x is the
+/// number of codes whose first float (found once, by bisection over the float bit patterns of
+/// [0, 1]) is at most x. A table per 2^16 bit patterns gives the code where the bucket starts;
+/// the few buckets that hold the first float of the next code (no bucket holds two: the
+/// steepest part, at 0, climbs 0.08 codes a bucket) step on to it.
+class SrgbTable {
+ public:
+  SrgbTable() {
+    mFirst[0] = 0.0f;
+    for (int code = 1; code < 256; ++code) {
+      std::uint32_t lo = 0, hi = std::bit_cast<std::uint32_t>(1.0f);  // the formula gives 255 at hi
+      while (lo < hi) {
+        const std::uint32_t mid = lo + (hi - lo) / 2;
+        if (linearToSrgb8Formula(std::bit_cast<float>(mid)) >= code)
+          hi = mid;
+        else
+          lo = mid + 1;
+      }
+      mFirst[std::size_t(code)] = std::bit_cast<float>(lo);
+    }
+    mFirst[256] = std::numeric_limits<float>::infinity();
+    for (std::uint32_t b = 0; b < kBuckets; ++b) mBucket[b] = linearToSrgb8Formula(std::bit_cast<float>(b << kShift));
+  }
+  std::uint8_t operator()(float linear) const {
+    if (!(linear > 0.0f)) return 0;  // also NaN
+    if (linear >= 1.0f) return 255;
+    std::uint32_t code = mBucket[std::bit_cast<std::uint32_t>(linear) >> kShift];
+    while (linear >= mFirst[code + 1]) ++code;
+    return std::uint8_t(code);
+  }
+
+ private:
+  static constexpr std::uint32_t kShift = 16;
+  static constexpr std::uint32_t kBuckets = (std::bit_cast<std::uint32_t>(1.0f) >> kShift) + 1;
+  std::array<float, 257> mFirst;  ///< the first float of each code; then +inf
+  std::array<std::uint8_t, kBuckets> mBucket;
+};
+
+}  // namespace
+
+std::uint8_t linearToSrgb8(float linear) {
+  static const SrgbTable table;
+  return table(linear);
 }
 
 void writePng(const std::filesystem::path& path, const RenderImage& image) {

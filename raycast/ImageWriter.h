@@ -79,7 +79,9 @@ struct ExrContents {
 ExrContents readExr(const std::filesystem::path& path);
 
 /// sRGB encoding (IEC 61966-2-1) of a linear value clamped to [0, 1], as an 8-bit code
-/// (rounded to nearest). NaN gives 0.
+/// (rounded to nearest). NaN gives 0. From a table: the code linearToSrgb8Formula gives.
 std::uint8_t linearToSrgb8(float linear);
+/// The same by the formula (a pow a call): what the table is made from and checked against.
+std::uint8_t linearToSrgb8Formula(float linear);
 
 }  // namespace flipscope

@@ -6,6 +6,7 @@
 
 #include <Imath/half.h>
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -146,6 +147,34 @@ TEST_F(ImageWriter, ReadExrRejectsMissingAndTruncatedFiles) {
   flipscope::writeExr(dir / "t.exr", randomImage(64, 64, 5));
   fs::resize_file(dir / "t.exr", fs::file_size(dir / "t.exr") / 2);
   EXPECT_THROW(flipscope::readExr(dir / "t.exr"), flipscope::FileError);
+}
+
+TEST_F(ImageWriter, TheSrgbTableGivesTheFormulasCodeForEveryFloat) {
+  // Where the table could go wrong: at the first float of each code, and the one before it
+  // (found here by bisection over the bit patterns, as the table's are), and in between.
+  for (int code = 1; code < 256; ++code) {
+    std::uint32_t lo = 0, hi = std::bit_cast<std::uint32_t>(1.0f);
+    while (lo < hi) {
+      const std::uint32_t mid = lo + (hi - lo) / 2;
+      if (flipscope::linearToSrgb8Formula(std::bit_cast<float>(mid)) >= code)
+        hi = mid;
+      else
+        lo = mid + 1;
+    }
+    for (const std::uint32_t bits : {lo - 1, lo, lo + 1}) {
+      const float x = std::bit_cast<float>(bits);
+      ASSERT_EQ(flipscope::linearToSrgb8(x), flipscope::linearToSrgb8Formula(x)) << "x = " << x << ", code " << code;
+    }
+    EXPECT_EQ(flipscope::linearToSrgb8(std::bit_cast<float>(lo)), code);
+  }
+  for (std::uint32_t bits = 0; bits <= std::bit_cast<std::uint32_t>(1.0f); bits += 997) {
+    const float x = std::bit_cast<float>(bits);
+    ASSERT_EQ(flipscope::linearToSrgb8(x), flipscope::linearToSrgb8Formula(x)) << "x = " << x;
+  }
+  for (const float x :
+       {-0.0f, -1e-30f, 1.0f, 1.5f, std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
+        std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::denorm_min()})
+    EXPECT_EQ(flipscope::linearToSrgb8(x), flipscope::linearToSrgb8Formula(x)) << "x = " << x;
 }
 
 TEST_F(ImageWriter, SrgbEncodingOfKnownValues) {
