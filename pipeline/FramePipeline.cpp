@@ -85,7 +85,8 @@ struct FramePipeline::Stages {
 
 FramePipeline::FramePipeline(BrickStore store, DeviceChoice device, const RenderSettings& settings,
                              const SurfaceSettings& surface, std::string* fallbackReason)
-    : FramePipeline(std::make_shared<StoreBrickSource>(std::move(store)), device, settings, surface, fallbackReason) {}
+    : FramePipeline(std::make_shared<StoreBrickSource>(std::move(store), settings.attributes), device, settings,
+                    surface, fallbackReason) {}
 
 float thicknessSaturationCells(const ShadingOptions& shading) {
   // §3.6: the trace behind a hit goes on until the least absorbed channel keeps 1% (ln 100).
@@ -120,6 +121,8 @@ void FramePipeline::init(std::shared_ptr<BrickSource> source,
   if (surface.shading.colorByAttribute && source->header().attribute == AttributeKind::None)
     throw InputError(source->name() +
                      ": the store has no per-particle attribute to colour by (convert with --attribute)");
+  FLIPSCOPE_CHECK(!surface.shading.colorByAttribute || source->carriesAttributes(),
+                  "colour by the attribute of a source that leaves it out (RenderSettings::attributes)");
   if (surface.shading.colorRange && !(surface.shading.colorRange->x < surface.shading.colorRange->y))
     throw InputError("--color-range: A must be less than B");
   const EnvironmentMap map = surface.environment.empty() ? EnvironmentMap{} : loadEnvironmentMap(surface.environment);
@@ -249,9 +252,8 @@ void FramePipeline::shade(int frame, const Camera& camera, StageTimes& stages) {
   // The spheres shading lights the sphere normals; the surface's are not reconstructed.
   if (!s.litSpheres) timed(stages.normals, [&] { reconstructNormals(device, s.smoothedDepth(), s.normals); });
   // The attribute values of the G-buffer's 0 and 1: the frame's quantization range.
-  const StoreHeader& header = mRenderer->source().header();
   const FrameStats stats =
-      header.attribute != AttributeKind::None ? mRenderer->source().frame(frame)->stats : FrameStats{};
+      mRenderer->source().carriesAttributes() ? mRenderer->source().frame(frame)->stats : FrameStats{};
   s.shading->setFrameAttributeRange(stats.attributeMin, stats.attributeMax);
   timed(stages.shading, [&] { s.shading->shade(device, s.gbuffer, s.normals, s.sphereNormals, s.shaded); });
   s.shadedReadOut = false;
@@ -265,7 +267,7 @@ const FrameOutput& FramePipeline::readOutput() {
   out.stats = {};
   out.stages = {};
   const StoreHeader& header = mRenderer->source().header();
-  const bool attribute = header.attribute != AttributeKind::None;
+  const bool attribute = mRenderer->source().carriesAttributes();
   const FrameStats stats = attribute ? mRenderer->source().frame(mFrame)->stats : FrameStats{};
   RenderImage& image = out.image;
   image.width = device.width();

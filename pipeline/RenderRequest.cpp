@@ -16,6 +16,8 @@ ResolvedRender resolve(const RenderRequest& request, const BrickStore& store) {
                      "convert with --attribute NAME");
   out.surface.shading.colorByAttribute =
       request.colorByAttribute.value_or(out.surface.shading.mode == ShadingMode::Attribute && hasAttribute);
+  out.settings.attributes = hasAttribute && (request.attributeOutput || out.surface.shading.colorByAttribute ||
+                                             out.surface.shading.mode == ShadingMode::Attribute);
   if (out.surface.shading.colorByAttribute && !out.surface.shading.colorRange)
     if (const auto range = store.attributeRange(); range && range->max > range->min)
       out.surface.shading.colorRange = glm::vec2(range->min, range->max);

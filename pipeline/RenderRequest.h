@@ -26,6 +26,9 @@ struct RenderRequest {
   /// The scene's up axis (the default camera's, the navigation's, the sky's); unset: the one
   /// the store records (StoreHeader::upAxis), +y when it records none.
   std::optional<UpAxis> up;
+  /// The output keeps the attribute's values (an EXR's channel); false for a PNG. Without it,
+  /// a look that does not colour by the attribute reads none (RenderSettings::attributes).
+  bool attributeOutput = true;
 };
 
 struct ResolvedRender {
@@ -34,7 +37,8 @@ struct ResolvedRender {
 };
 
 /// The settings `request` gives for `store`. Throws InputError naming `store` when colour by
-/// attribute is asked of a store without one.
+/// attribute is asked of a store without one. settings.attributes: whether the output or the
+/// look uses the store's attribute.
 ResolvedRender resolve(const RenderRequest& request, const BrickStore& store);
 
 /// The camera a render frames when none is given: frameOnBox over the occupied cells of every

@@ -63,12 +63,13 @@ void validate(const RenderSettings& s) {
 }
 
 namespace {
-StreamerOptions streamerOptions(const StoreHeader& header, const RenderSettings& settings, std::uint32_t reach) {
+/// `attributes`: the source's bricks carry attribute values (BrickSource::carriesAttributes).
+StreamerOptions streamerOptions(const StoreHeader& header, bool attributes, const RenderSettings& settings,
+                                std::uint32_t reach) {
   StreamerOptions options;
   options.conversion.brickSize = header.brickSize;
   options.conversion.overlap = storedOverlap(settings);
-  options.conversion.attribute =
-      header.attribute == AttributeKind::None ? AttributeReduction::None : AttributeReduction::Max;
+  options.conversion.attribute = attributes ? AttributeReduction::Max : AttributeReduction::None;
   options.conversion.hideBubbles = header.particleKinds && settings.foam.hideBubbles;
   options.conversion.foamKinds = header.particleKinds && settings.foam.usesKinds();
   options.mipDilation = reach;
@@ -80,10 +81,10 @@ StreamerOptions streamerOptions(const StoreHeader& header, const RenderSettings&
 
 /// The largest pool within the budget, shrunk until its largest buffer (the bits) fits the
 /// device.
-PoolLayout budgetPoolLayout(const StoreHeader& header, const RenderSettings& settings, const RaycastDevice& device) {
+PoolLayout budgetPoolLayout(const StoreHeader& header, bool attributes, const RenderSettings& settings,
+                            const RaycastDevice& device) {
   const std::uint64_t maxBufferBytes = device.maxBufferBytes();
   validate(settings);
-  const bool attributes = header.attribute != AttributeKind::None;
   const bool foam = settings.foam.mode != FoamMode::Keep;
   std::uint64_t budget = settings.gpuBudgetBytes;
   for (;;) {
@@ -111,10 +112,11 @@ FrameRenderer::FrameRenderer(std::shared_ptr<BrickSource> source, std::unique_pt
       mSettings(settings),
       mReach(sphereReach(settings.radius, settings.jitter)),
       mOverlap(storedOverlap(settings)),
-      mBudgetPool(budgetPoolLayout(mSource->header(), settings, *mDevice)),
+      mBudgetPool(budgetPoolLayout(mSource->header(), mSource->carriesAttributes(), settings, *mDevice)),
       mPool(mBudgetPool.withSlots(0)) {
   mDevice->allocatePool(mPool.layout());
-  mStreamer = std::make_unique<Streamer>(mSource, streamerOptions(mSource->header(), settings, mReach));
+  mStreamer = std::make_unique<Streamer>(
+      mSource, streamerOptions(mSource->header(), mSource->carriesAttributes(), settings, mReach));
 }
 
 FrameRenderer::~FrameRenderer() = default;

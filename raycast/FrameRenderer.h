@@ -44,6 +44,10 @@ struct RenderSettings {
   /// Liquid cells at which the thickness trace behind a hit stops, absorption having saturated
   /// (§3.6; FramePipeline derives it from the shading's absorption); 0: no thickness.
   float thicknessSaturationCells = 64.0f;
+  /// Whether a store's per-particle attribute is read at all: false where the image shows none
+  /// (resolve() decides). FramePipeline's store gives bricks without it then
+  /// (StoreBrickSource); the renderer follows what its source carries.
+  bool attributes = true;
 };
 /// Throws InputError naming the setting that is out of range.
 void validate(const RenderSettings& settings);

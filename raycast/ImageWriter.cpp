@@ -267,6 +267,8 @@ void writePng(const std::filesystem::path& path, const RenderImage& image) {
   reportingErrors<OutputError>(path, [&] { writeFileAtomically(path, encoded); });
 }
 
+bool keepsAttributeChannel(const std::filesystem::path& path) { return lowerExtension(path) == ".exr"; }
+
 bool isImagePath(const std::filesystem::path& path) {
   const std::string extension = lowerExtension(path);
   return extension == ".exr" || extension == ".png";

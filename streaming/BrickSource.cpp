@@ -26,7 +26,7 @@ std::shared_ptr<const DecodedBrick> StoreBrickSource::read(const BrickKey& key) 
   if (key.coord.x >= grid.x || key.coord.y >= grid.y || key.coord.z >= grid.z) return nullptr;
   std::int64_t index = frame->octree.find(key.coord);
   if (index < 0) return nullptr;
-  return std::make_shared<const DecodedBrick>(mStore.readBrick(*frame, std::uint32_t(index)));
+  return std::make_shared<const DecodedBrick>(mStore.readBrick(*frame, std::uint32_t(index), mAttributes));
 }
 
 Box occupiedBounds(BrickSource& source, int first, int last) {

@@ -23,6 +23,7 @@ class DelayedBrickSource : public BrickSource {
     std::this_thread::sleep_for(mDelay);
     return mInner->read(key);
   }
+  bool carriesAttributes() const override { return mInner->carriesAttributes(); }
   std::string name() const override { return mInner->name(); }
 
  private:

@@ -44,6 +44,9 @@ void runStage(const FrameStageArgs& a) {
     request.surface.shading.mode = ShadingMode::Spheres;
     request.settings.foam.mode = FoamMode::Keep;  // as the peer: every particle a sphere
   }
+  // As `render` to a PNG: the images this stage keeps are looked at, and their EXR compared by
+  // depth; a look that does not colour by the attribute reads none.
+  request.attributeOutput = false;
   const ResolvedRender look = resolve(request, store);
   FramePipeline pipeline(std::move(store), parseDeviceChoice("--device", a.request.device), look.settings,
                          look.surface);

@@ -44,7 +44,9 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
     throw InputError("-o: rendering frames " + std::to_string(first) + "-" + std::to_string(last) +
                      " needs '#' in the output name (e.g. out_####.exr)");
 
-  const auto [settings, surface] = resolve(job, store);
+  RenderRequest request = job;
+  request.attributeOutput = keepsAttributeChannel(job.output);  // a PNG's look may need none
+  const auto [settings, surface] = resolve(request, store);
   const StoreHeader& header = store.header();
   std::string fallback;
   FramePipeline pipeline(store, job.device, settings, surface, &fallback);

@@ -134,11 +134,29 @@ std::vector<std::byte> decompressStreamed(std::span<const std::byte> payload, st
   return raw;
 }
 
+/// The first raw.size() bytes of the payload's zstd frame into `raw`, the rest of it left
+/// compressed (zstd stops when the output is full).
+template <class Fail>
+void decompressPrefix(std::span<const std::byte> payload, std::vector<std::byte>& raw, const Fail& fail) {
+  ZSTD_DCtx* context = threadDecompressor();
+  ZSTD_DCtx_reset(context, ZSTD_reset_session_only);
+  ZSTD_inBuffer input{payload.data(), payload.size(), 0};
+  ZSTD_outBuffer out{raw.data(), raw.size(), 0};
+  while (out.pos < out.size) {
+    const std::size_t consumed = input.pos, produced = out.pos;
+    const std::size_t hint = ZSTD_decompressStream(context, &out, &input);
+    if (ZSTD_isError(hint)) throw fail(std::string("zstd: ") + ZSTD_getErrorName(hint));
+    if (hint == 0 && out.pos < out.size) throw fail("payload decompressed to fewer bytes than declared");
+    if (out.pos == produced && input.pos == consumed) throw fail("payload ends inside its zstd frame");
+  }
+  ZSTD_DCtx_reset(context, ZSTD_reset_session_only);  // the frame left unfinished
+}
+
 }  // namespace
 
 DecodedBrick decodeBrick(std::span<const std::byte> payload, const std::filesystem::path& file,
                          std::uint32_t brickIndex, const BrickRecord& expected, std::uint32_t cellsPerBrick,
-                         bool hasAttribute, bool hasKinds) {
+                         bool hasAttribute, bool hasKinds, bool readAttributes) {
   const std::string where = "brick " + std::to_string(brickIndex);
   auto fail = [&](const std::string& reason) -> FileError { return FileError(file, where + ": " + reason); };
 
@@ -152,13 +170,22 @@ DecodedBrick decodeBrick(std::span<const std::byte> payload, const std::filesyst
   if (declared == ZSTD_CONTENTSIZE_ERROR || declared == ZSTD_CONTENTSIZE_UNKNOWN)
     throw fail("payload is not a zstd frame of known size");
   if (declared > bound) throw fail("payload declares " + std::to_string(declared) + " bytes, more than possible");
+  const std::uint64_t attributeBytes = hasAttribute ? 2 * std::uint64_t(expected.particles) : 0;
+  if (declared < attributeBytes)
+    throw fail("payload declares " + std::to_string(declared) + " bytes, fewer than its " +
+               std::to_string(expected.particles) + " attribute values take");
+  const bool skipAttributes = hasAttribute && !readAttributes;
   ZSTD_DCtx* context = threadDecompressor();
   // The thread's buffer, kept from brick to brick: a fresh one per brick cost a first touch of
   // its pages each time (most of the page faults of a large first image).
   // One larger than a one-shot read is let go after this brick.
   thread_local std::vector<std::byte> raw;
   const ReleaseLarge<std::vector<std::byte>> release{raw, kOneShotBytes};
-  if (declared <= std::max<std::uint64_t>(kOneShotBytes, 64 * std::uint64_t(payload.size()))) {
+  if (skipAttributes) {
+    // The streams before the attributes: they are last, two bytes a particle.
+    raw.resize(std::size_t(declared - attributeBytes));
+    decompressPrefix(payload, raw, fail);
+  } else if (declared <= std::max<std::uint64_t>(kOneShotBytes, 64 * std::uint64_t(payload.size()))) {
     raw.resize(declared);
     const std::size_t n = ZSTD_decompressDCtx(context, raw.data(), raw.size(), payload.data(), payload.size());
     if (ZSTD_isError(n)) throw fail(std::string("zstd: ") + ZSTD_getErrorName(n));
@@ -201,7 +228,7 @@ DecodedBrick decodeBrick(std::span<const std::byte> payload, const std::filesyst
       brick.kinds[i] = ParticleKind(kind);
     }
   }
-  if (hasAttribute) {
+  if (hasAttribute && !skipAttributes) {
     brick.attributes.resize(particles);
     in.getArray(std::span<std::uint16_t>(brick.attributes), "attributes");
   }

@@ -703,10 +703,10 @@ std::vector<std::byte> BrickStore::readPayload(const FrameIndex& frame, std::uin
   return payload;
 }
 
-DecodedBrick BrickStore::readBrick(const FrameIndex& frame, std::uint32_t brickIndex) const {
+DecodedBrick BrickStore::readBrick(const FrameIndex& frame, std::uint32_t brickIndex, bool attributes) const {
   auto payload = readPayload(frame, brickIndex);
   return decodeBrick(payload, frame.file, brickIndex, frame.bricks[brickIndex], mHeader.cellsPerBrick(),
-                     mHeader.attribute != AttributeKind::None, mHeader.particleKinds);
+                     mHeader.attribute != AttributeKind::None, mHeader.particleKinds, attributes);
 }
 
 }  // namespace flipscope

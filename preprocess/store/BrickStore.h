@@ -167,10 +167,12 @@ struct DecodedBrick {
 std::vector<std::byte> encodeBrick(const DecodedBrick& brick, int zstdLevel);
 /// Throws FileError naming `file` and `brickIndex` on any malformation; checks `expected`
 /// particle and cell counts, that every cell index is < cellsPerBrick and, with `hasKinds`,
-/// that every kind is < kParticleKindCount.
-DecodedBrick decodeBrick(std::span<const std::byte> payload, const std::filesystem::path& file, std::uint32_t brickIndex,
-                         const BrickRecord& expected, std::uint32_t cellsPerBrick, bool hasAttribute,
-                         bool hasKinds);
+/// that every kind is < kParticleKindCount. Without `readAttributes`, a payload's attribute
+/// values (`hasAttribute`) stay compressed and `attributes` empty: only the streams before them
+/// are decompressed and checked (a render that shows no attribute; most of a payload's bytes).
+DecodedBrick decodeBrick(std::span<const std::byte> payload, const std::filesystem::path& file,
+                         std::uint32_t brickIndex, const BrickRecord& expected, std::uint32_t cellsPerBrick,
+                         bool hasAttribute, bool hasKinds, bool readAttributes = true);
 
 class BrickStore {
  public:
@@ -211,8 +213,9 @@ class BrickStore {
   /// InputError for a frame the table does not list, FileError naming the file when it is
   /// missing, damaged or from another store.
   std::shared_ptr<const FrameIndex> frame(int frame) const;
-  /// Reads, verifies and decodes one brick. Thread safe.
-  DecodedBrick readBrick(const FrameIndex& frame, std::uint32_t brickIndex) const;
+  /// Reads, verifies and decodes one brick; without `attributes`, leaves its attribute values
+  /// compressed (decodeBrick's readAttributes). Thread safe.
+  DecodedBrick readBrick(const FrameIndex& frame, std::uint32_t brickIndex, bool attributes = true) const;
   /// Reads one brick's compressed payload and verifies its checksum. Thread safe.
   std::vector<std::byte> readPayload(const FrameIndex& frame, std::uint32_t brickIndex) const;
 

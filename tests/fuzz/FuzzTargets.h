@@ -29,6 +29,7 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -232,11 +233,22 @@ inline Result brickPayload(std::span<const std::byte> input) {
     payload = compressed;
   }
   record.bytes = std::uint32_t(payload.size());
+  // Without the attributes (a render that shows none) the streams before them decode alone.
+  std::optional<DecodedBrick> streams;
+  try {
+    streams = decodeBrick(payload, "brick", 0, record, brickSize * brickSize * brickSize, attribute, kinds, false);
+    if (streams->particleCount() != record.particles || streams->cells.size() != record.cells ||
+        !streams->attributes.empty())
+      throw LogicError("decodeBrick without attributes accepted a brick that does not match its record");
+  } catch (const FileError&) {
+  }
   try {
     const DecodedBrick brick =
         decodeBrick(payload, "brick", 0, record, brickSize * brickSize * brickSize, attribute, kinds);
     if (brick.particleCount() != record.particles || brick.cells.size() != record.cells)
       throw LogicError("decodeBrick accepted a brick that does not match its record");
+    if (!streams || streams->cells != brick.cells || streams->counts != brick.counts || streams->kinds != brick.kinds)
+      throw LogicError("a brick decodes differently without its attributes");
     // What decodes must encode to the same brick.
     const DecodedBrick again =
         decodeBrick(encodeBrick(brick, 1), "brick", 0, record, brickSize * brickSize * brickSize, attribute, kinds);

@@ -8,6 +8,7 @@
 #include "TestSupport.h"
 #include "core/Error.h"
 #include "pipeline/FramePipeline.h"
+#include "pipeline/RenderRequest.h"
 #include "raycast/RaycastScenes.h"
 
 namespace flipscope {
@@ -126,6 +127,60 @@ TEST(ColorByAttribute, AStoreWithoutAttributeIsRefused) {
                InputError);
   const RenderImage plain = render(ball.makeStore(dir.path() / "plain"), ShadingMode::Liquid, false);
   EXPECT_TRUE(plain.attribute.empty());
+}
+
+TEST(ColorByAttribute, AnImageThatShowsNoAttributeReadsNone) {
+  // RenderSettings::attributes off (a PNG, no colour by it): the bricks come without their
+  // values (StoreBrickSource), the pool without their ring, the image without the channel; the
+  // look is the same to the bit.
+  testing::TempDir dir("color-read-none");
+  const BrickStore store = speedBall(dir.path() / "store");
+  const testing::BallScene ball;
+  for (ShadingMode mode : {ShadingMode::Liquid, ShadingMode::Spheres}) {
+    SCOPED_TRACE(int(mode));
+    SurfaceSettings surface;
+    surface.shading.mode = mode;
+    RenderSettings settings = ball.settings();
+    FramePipeline with(store, DeviceChoice::Cpu, settings, surface);
+    settings.attributes = false;
+    FramePipeline without(store, DeviceChoice::Cpu, settings, surface);
+    EXPECT_TRUE(with.renderer().source().carriesAttributes());
+    EXPECT_FALSE(without.renderer().source().carriesAttributes());
+    const BrickKey key{0, store.frame(0)->bricks.front().coord};
+    EXPECT_FALSE(with.renderer().source().read(key)->attributes.empty());
+    EXPECT_TRUE(without.renderer().source().read(key)->attributes.empty());
+    const FrameOutput a = with.render(0, ball.camera());
+    const FrameOutput b = without.render(0, ball.camera());
+    ASSERT_EQ(a.image.rgba.size(), b.image.rgba.size());
+    for (std::size_t i = 0; i < a.image.rgba.size(); ++i) {
+      ASSERT_EQ(a.image.rgba[i], b.image.rgba[i]) << "pixel " << i;
+      ASSERT_EQ(std::isfinite(a.image.depth[i]), std::isfinite(b.image.depth[i])) << "pixel " << i;
+    }
+    EXPECT_EQ(a.image.attribute.size(), a.image.rgba.size());
+    EXPECT_TRUE(b.image.attribute.empty());
+    EXPECT_TRUE(b.image.attributeName.empty());
+    EXPECT_LT(b.stats.poolBytes, a.stats.poolBytes);
+  }
+}
+
+TEST(ColorByAttribute, TheAttributeIsReadWhereTheOutputOrTheLookUsesIt) {
+  testing::TempDir dir("color-resolve");
+  const BrickStore store = speedBall(dir.path() / "store");
+  const auto attributes = [&](bool output, std::optional<bool> colour, ShadingMode mode) {
+    RenderRequest request;
+    request.attributeOutput = output;
+    request.colorByAttribute = colour;
+    request.surface.shading.mode = mode;
+    return resolve(request, store).settings.attributes;
+  };
+  EXPECT_TRUE(attributes(true, std::nullopt, ShadingMode::Liquid));  // an EXR's channel
+  EXPECT_FALSE(attributes(false, std::nullopt, ShadingMode::Liquid));
+  EXPECT_FALSE(attributes(false, std::nullopt, ShadingMode::Spheres));
+  EXPECT_TRUE(attributes(false, true, ShadingMode::Liquid));
+  EXPECT_TRUE(attributes(false, std::nullopt, ShadingMode::Attribute));
+  const BrickStore plain = testing::BallScene().makeStore(dir.path() / "plain");
+  RenderRequest request;
+  EXPECT_FALSE(resolve(request, plain).settings.attributes);  // none to read
 }
 
 }  // namespace

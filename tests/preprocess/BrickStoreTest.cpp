@@ -56,6 +56,60 @@ TEST(BrickCodec, RoundTripsRandomBricks) {
   }
 }
 
+TEST(BrickCodec, DecodingWithoutAttributesLeavesThemOutAndKeepsTheRest) {
+  // Dense bricks too, whose streams before the attributes span several zstd blocks (128 KiB):
+  // decompression stops inside the frame.
+  std::mt19937 rng(17);
+  for (const std::uint32_t cells : {200u, 100000u})
+    for (const bool kinds : {false, true})
+      for (const bool attribute : {false, true}) {
+        DecodedBrick brick;
+        for (std::uint32_t c = 0; c < cells; ++c) {
+          brick.cells.push_back(c * (64 * 64 * 64 / cells) + std::uint32_t(rng() % 2));
+          brick.counts.push_back(1 + rng() % 12);
+          if (kinds) brick.kinds.push_back(ParticleKind(rng() % kParticleKindCount));
+          if (attribute)
+            for (std::uint32_t i = 0; i < brick.counts.back(); ++i) brick.attributes.push_back(std::uint16_t(rng()));
+        }
+        const std::vector<std::byte> payload = encodeBrick(brick, 1);
+        BrickRecord r;
+        r.cells = std::uint32_t(brick.cells.size());
+        r.particles = std::uint32_t(brick.particleCount());
+        const DecodedBrick back = decodeBrick(payload, "x.fsf", 3, r, 64 * 64 * 64, attribute, kinds, false);
+        EXPECT_EQ(back.cells, brick.cells) << cells << " cells";
+        EXPECT_EQ(back.counts, brick.counts);
+        EXPECT_EQ(back.kinds, brick.kinds);
+        EXPECT_TRUE(back.attributes.empty());
+        // The streams before the attributes are checked as a whole decode checks them: a count
+        // the table does not hold, and a payload cut inside them, are errors.
+        BrickRecord more = r;
+        ++more.particles;
+        EXPECT_THROW(decodeBrick(payload, "x.fsf", 3, more, 64 * 64 * 64, attribute, kinds, false), FileError);
+        DecodedBrick streams = brick;  // the payload's bytes before the attributes: about these
+        streams.attributes.clear();
+        const std::span<const std::byte> cut(payload.data(), encodeBrick(streams, 1).size() / 2);
+        EXPECT_THROW(decodeBrick(cut, "x.fsf", 3, r, 64 * 64 * 64, attribute, kinds, false), FileError);
+      }
+}
+
+TEST(BrickCodec, APayloadTooShortForItsAttributesIsRefusedWithoutThem) {
+  // A payload of a store without an attribute read as one with: it declares fewer bytes than
+  // its particles' values would take.
+  DecodedBrick brick;
+  brick.cells = {1, 5, 9};
+  brick.counts = {400, 400, 400};
+  BrickRecord r;
+  r.cells = 3;
+  r.particles = 1200;
+  try {
+    decodeBrick(encodeBrick(brick, 1), "x.fsf", 4, r, 64 * 64 * 64, true, false, false);
+    ADD_FAILURE() << "decoded";
+  } catch (const FileError& e) {
+    EXPECT_NE(std::string(e.what()).find("fewer than its 1200 attribute values take"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("brick 4"), std::string::npos) << e.what();
+  }
+}
+
 TEST(BrickCodec, RejectsWrongCountsAndGarbage) {
   std::mt19937 rng(5);
   DecodedBrick brick = randomBrick(rng, 32 * 32 * 32, false);

@@ -116,6 +116,7 @@ TEST_F(AttributeCli, RenderColoursByTheAttributeAndTheExrCarriesIt) {
   EXPECT_GT(differing(viridis, spheres), covered / 2);
 
   // The EXR's `temperature` channel: the attribute's values where the slab is, 0 elsewhere.
+  EXPECT_EQ(plain.others.count("temperature"), 1u) << "an EXR keeps the attribute without colour by it";
   ASSERT_EQ(viridis.others.count("temperature"), 1u);
   const auto& values = viridis.others.at("temperature");
   ASSERT_EQ(values.size(), viridis.image.rgba.size());
@@ -132,6 +133,25 @@ TEST_F(AttributeCli, RenderColoursByTheAttributeAndTheExrCarriesIt) {
   }
   EXPECT_LT(lowest, 0.0f);
   EXPECT_GT(highest, 5.0f);
+}
+
+TEST_F(AttributeCli, APngThatShowsNoAttributeReadsNone) {
+  // The attribute read, or not, shows in the pool the log line reports: its values take a ring
+  // of their own. A PNG holds only the look: without colour by the attribute, none is read.
+  ASSERT_EQ(
+      runFlipscope("convert " + path("slab.ply") + " -o " + path("store") + " --attribute temperature -q").exitCode, 0);
+  const auto pool = [&](const std::string& name, const std::string& options) {
+    const CommandRun r =
+        runFlipscope("render " + path("store") + " -o " + path(name) + " --size 96x54 --device cpu " + options);
+    EXPECT_EQ(r.exitCode, 0) << options << "\n" << r.output;
+    const std::size_t at = r.output.find("(pool ");
+    EXPECT_NE(at, std::string::npos) << r.output;
+    return at == std::string::npos ? std::string() : r.output.substr(at, r.output.find(')', at) - at);
+  };
+  const std::string exr = pool("a.exr", ""), png = pool("a.png", ""), coloured = pool("c.png", "--color-by attribute");
+  EXPECT_NE(png, exr);
+  EXPECT_EQ(coloured, exr);
+  EXPECT_EQ(pool("s.png", "--shading attribute"), exr);
 }
 
 TEST_F(AttributeCli, BadColourOptionsExitWith2ListingTheValidValues) {
