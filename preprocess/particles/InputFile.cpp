@@ -134,8 +134,10 @@ void InputFile::readExact(void* data, std::size_t bytes, const char* what) {
 
 bool InputFile::readScattered(std::span<const std::uint64_t> offsets, std::size_t bytes, std::byte* data) {
   if (!mSource->randomAccess()) return false;
-  mSource->willRead(offsets, bytes);
+  // Each thread announces its own reads, then reads them: the announcements (a system call
+  // each, about as long as a read when the file is cached) run on both threads too.
   const auto readRanges = [&](std::size_t begin, std::size_t end) {
+    mSource->willRead(offsets.subspan(begin, end - begin), bytes);
     for (std::size_t i = begin; i < end; ++i)
       if (mSource->readAt(offsets[i], data + i * bytes, bytes) != bytes)
         throw FileError(mPath, "file ends before byte " + std::to_string(offsets[i] + bytes) +
