@@ -166,12 +166,13 @@ std::optional<Sample> sampleByNumber(ParticleSource& source, std::size_t size) {
 
 /// The k-th neighbour distance of every query among the candidates given to add(), searched as
 /// far as `radius`: a query whose k-th neighbour is farther keeps +inf. A grid of cells of the
-/// radius (coarser where that would exceed kMaxSearchCells, or kMaxAxisCells along an axis) covers the queries' bounds
-/// grown by the radius, and each cell lists the queries within reach of some point of it. A candidate looks up its own
-/// cell only (found in floats, four at a time): a bit turns it away when the list is empty (most candidates lie far
-/// from every query), else it measures its distance to each listed query. The reach is the radius plus a margin for the
-/// rounding of a candidate's cell, so the lists are a superset and the search is exact. A candidate with the id of a
-/// query is that query itself and skipped.
+/// radius (coarser where that would exceed kMaxSearchCells, or kMaxAxisCells along an axis)
+/// covers the queries' bounds grown by the radius, and each cell lists the queries within reach
+/// of some point of it. A candidate looks up its own cell only (found in floats, four at a
+/// time): a bit turns it away when the list is empty (most candidates lie far from every query),
+/// else it measures its distance to each listed query. The reach is the radius plus a margin for
+/// the rounding of a candidate's cell, so the lists are a superset and the search is exact. A
+/// candidate with the id of a query is that query itself and skipped.
 class KthNeighbours {
  public:
   /// Cells of the radius, not of half of it, for the frame's pass too: there, fewer candidates

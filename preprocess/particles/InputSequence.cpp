@@ -11,7 +11,6 @@
 
 #include "core/Error.h"
 #include "preprocess/particles/ParticleFormatRegistry.h"
-#include "preprocess/particles/ParticleFormats.h"
 
 namespace flipscope {
 namespace {
@@ -87,16 +86,6 @@ std::vector<int> discoverFrames(const std::string& input, const FramePattern& pa
   return {frames.begin(), frames.end()};
 }
 
-/// Whether `name` ends with a particle format's extension: the extension's length, else 0.
-std::size_t particleExtensionLength(const std::string& name) {
-  const std::string lower = detail::asciiLower(name);
-  std::size_t longest = 0;
-  for (const ParticleFormat& format : particleFormats())
-    for (std::string_view extension : format.extensions)
-      if (lower.size() > extension.size() && lower.ends_with(extension)) longest = std::max(longest, extension.size());
-  return longest;
-}
-
 /// The numbered particle files in `dir` and in its sub-directories one level down, as input
 /// patterns (the number's last run of digits as '#', one per digit of the shortest) with how
 /// many files each has, the most first, at most `limit`: "'dir/data/fluid_data_####.vdb' (30
@@ -120,7 +109,7 @@ std::vector<std::string> numberedSequencesIn(const std::filesystem::path& dir, s
         continue;
       }
       const std::size_t stem = name.size() - particleExtensionLength(name);
-      if (stem == name.size()) continue;
+      if (stem == name.size() || stem == 0) continue;  // not a particle file, or no more than its extension
       const std::size_t last = name.find_last_of("0123456789", stem - 1);
       if (last == std::string::npos) continue;
       const std::size_t first = name.find_last_not_of("0123456789", last) + 1;  // npos + 1 = 0

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <utility>
 
 #include "core/Error.h"
 #include "preprocess/particles/ParticleFormats.h"
@@ -80,8 +81,9 @@ bool endsWith(std::string_view text, std::string_view suffix) {
   return text.size() >= suffix.size() && text.substr(text.size() - suffix.size()) == suffix;
 }
 
-/// The format whose extension is the longest ending of `name`, or null.
-const ParticleFormat* formatByName(const std::string& name) {
+/// The format whose extension is the longest ending of `name` (lower case), and that
+/// extension's length; null and 0 when none is.
+std::pair<const ParticleFormat*, std::size_t> longestExtension(std::string_view name) {
   const ParticleFormat* best = nullptr;
   std::size_t bestLength = 0;
   for (const auto& format : formatTable())
@@ -90,10 +92,17 @@ const ParticleFormat* formatByName(const std::string& name) {
         best = &format;
         bestLength = extension.size();
       }
-  return best;
+  return {best, bestLength};
 }
 
+/// The format whose extension is the longest ending of `name` (lower case), or null.
+const ParticleFormat* formatByName(const std::string& name) { return longestExtension(name).first; }
+
 }  // namespace
+
+std::size_t particleExtensionLength(std::string_view fileName) {
+  return longestExtension(detail::asciiLower(fileName)).second;
+}
 
 std::span<const ParticleFormat> particleFormats() { return formatTable(); }
 std::span<const ContainerFormat> containerFormats() { return containerTable(); }

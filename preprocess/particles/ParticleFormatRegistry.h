@@ -48,6 +48,9 @@ std::span<const ParticleFormat> particleFormats();
 std::span<const ContainerFormat> containerFormats();
 /// The format named `name` (ParticleFormat::name), or null.
 const ParticleFormat* findParticleFormat(std::string_view name);
+/// The length of the longest particle format extension the file name `fileName` ends with, in
+/// any case (".bgeo.sc" of "Splash.0001.BGEO.SC"); 0 when it ends with none.
+std::size_t particleExtensionLength(std::string_view fileName);
 /// "  .vdb .ply ..." for messages.
 std::string supportedExtensions();
 
