@@ -9,6 +9,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -435,7 +436,7 @@ void decodeRun(std::uint64_t* all, const BrickParts& parts, const KeyGrid& grid,
 }  // namespace
 
 void binKeys(KeyBatch& keyBatch, const KeyGrid& grid, float min, float max, int zstdLevel,
-             const std::function<void(EncodedBrick&&)>& sink) {
+             const std::function<void(const EncodedBrick&)>& sink) {
   KeyFields fields;
   fields.kinds = grid.header.particleKinds;
   fields.min = min;
@@ -474,25 +475,32 @@ void binKeys(KeyBatch& keyBatch, const KeyGrid& grid, float min, float max, int 
     }
   }
 
-  constexpr std::size_t kBatch = 64;
-  std::vector<EncodedBrick> batch;
-  for (std::size_t first = 0; first < bricks.size(); first += kBatch) {
-    const std::size_t count = std::min(kBatch, bricks.size() - first);
-    batch.assign(count, {});
-    tbb::parallel_for(std::size_t(0), count, [&](std::size_t i) {
-      const BrickParts& parts = bricks[first + i];
-      thread_local DecodedBrick brick;
-      thread_local DecodeScratch scratch;
-      decodeRun(keys.data(), parts, grid, fields, attribute, brick, scratch);
-      EncodedBrick& e = batch[i];
-      for (ParticleKind kind : brick.kinds) ++e.kindCells[std::size_t(kind)];
-      e.coord = glm::uvec3(mortonDecode3(std::uint32_t(parts.code)));
-      e.particles = std::uint32_t(parts.keys());
-      e.cells = std::uint32_t(brick.cells.size());
-      e.payload = encodeBrick(brick, zstdLevel);
-    });
-    for (auto& e : batch) sink(std::move(e));
-  }
+  // Bricks are encoded in parallel and handed to the sink in order as each is done, through a
+  // ring of kept payload buffers: brick k goes to slot k % slots, free by then since a pipeline
+  // of that many tokens starts brick k only when brick k - slots has left the sink.
+  const std::size_t slots = 2 * std::size_t(tbb::this_task_arena::max_concurrency());
+  std::vector<EncodedBrick> ring(slots);
+  std::size_t next = 0;
+  tbb::parallel_pipeline(
+      slots, tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order, [&](tbb::flow_control& control) {
+               if (next == bricks.size()) control.stop();
+               return next++;
+             }) & tbb::make_filter<std::size_t, std::size_t>(tbb::filter_mode::parallel, [&](std::size_t k) {
+               const BrickParts& parts = bricks[k];
+               thread_local DecodedBrick brick;
+               thread_local DecodeScratch scratch;
+               decodeRun(keys.data(), parts, grid, fields, attribute, brick, scratch);
+               EncodedBrick& e = ring[k % slots];
+               e.kindCells = {};
+               for (ParticleKind kind : brick.kinds) ++e.kindCells[std::size_t(kind)];
+               e.coord = glm::uvec3(mortonDecode3(std::uint32_t(parts.code)));
+               e.particles = std::uint32_t(parts.keys());
+               e.cells = std::uint32_t(brick.cells.size());
+               encodeBrickInto(brick, zstdLevel, e.payload);
+               return k;
+             }) & tbb::make_filter<std::size_t, void>(tbb::filter_mode::serial_in_order, [&](std::size_t k) {
+               sink(ring[k % slots]);
+             }));
 }
 
 }  // namespace flipscope::detail

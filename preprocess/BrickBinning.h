@@ -124,7 +124,7 @@ struct EncodedBrick {
   std::uint32_t particles = 0;
   std::uint32_t cells = 0;
   std::array<std::uint32_t, kParticleKindCount> kindCells{};  ///< cells of each kind (with kinds)
-  std::vector<std::byte> payload;
+  UninitializedVector<std::byte> payload;
 };
 
 /// Sorts the keys of `batch` by brick in place (in stripes, see BrickBinning.cpp), groups them
@@ -132,9 +132,10 @@ struct EncodedBrick {
 /// ascending Morton order. The attribute is quantized over [min, max] (quantizeAttribute) as
 /// each key is read: the bricks are those of the binning keys (binningKey), without a pass over
 /// every key that makes them first, except where the values lie beside the keys. Frees the
-/// batch's values; its keys are left in another order. Memory: keys + one batch of compressed
-/// payloads.
+/// batch's values; its keys are left in another order. Memory: keys + twice the threads'
+/// count of compressed payloads. `sink` runs on any one thread at a time; the brick it is
+/// given is valid only during the call.
 void binKeys(KeyBatch& batch, const KeyGrid& grid, float min, float max, int zstdLevel,
-             const std::function<void(EncodedBrick&&)>& sink);
+             const std::function<void(const EncodedBrick&)>& sink);
 
 }  // namespace flipscope::detail

@@ -381,7 +381,7 @@ class FrameBinner {
   /// Bins `batch` into `writer` (the batch is empty after).
   void binInMemory(KeyBatch& batch, FrameWriter& writer) {
     detail::binKeys(batch, mGrid, mStats.attributeMin, mStats.attributeMax, mOptions.zstdLevel,
-                    [&](detail::EncodedBrick&& brick) {
+                    [&](const detail::EncodedBrick& brick) {
                       writer.addBrick(brick.coord, brick.particles, brick.cells, brick.payload);
                       mStats.particles += brick.particles;
                       for (std::size_t k = 0; k < kParticleKindCount; ++k) mStats.kindCells[k] += brick.kindCells[k];

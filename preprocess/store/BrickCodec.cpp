@@ -63,16 +63,14 @@ std::uint64_t DecodedBrick::particleCount() const {
   return n;
 }
 
-std::vector<std::byte> encodeBrick(const DecodedBrick& brick, int zstdLevel) {
+void encodeBrickInto(const DecodedBrick& brick, int zstdLevel, UninitializedVector<std::byte>& payload) {
   FLIPSCOPE_CHECK(brick.cells.size() == brick.counts.size(), brick.cells.size() << " vs " << brick.counts.size());
   FLIPSCOPE_CHECK(brick.kinds.empty() || brick.kinds.size() == brick.cells.size(),
                   brick.kinds.size() << " kinds for " << brick.cells.size() << " cells");
-  // The raw streams, and zstd's output at its bound, in the thread's buffers: fresh ones per
-  // brick were a tenth of a 20 M particle convert (page faults, and the bound's memset).
+  // The raw streams in the thread's buffer: a fresh one per brick was a tenth of a 20 M
+  // particle convert (page faults).
   thread_local ByteWriter raw;
-  thread_local UninitializedVector<std::byte> compressed;
   const ReleaseLarge<std::vector<std::byte>> releaseRaw{raw.bytes(), kKeptEncodeBytes};
-  const ReleaseLarge<UninitializedVector<std::byte>> releaseCompressed{compressed, kKeptEncodeBytes};
   raw.bytes().clear();
   raw.bytes().reserve(brick.cells.size() * 2 + brick.kinds.size() + brick.attributes.size() * 2 + 8);
   raw.putVarint(brick.cells.size());
@@ -92,12 +90,18 @@ std::vector<std::byte> encodeBrick(const DecodedBrick& brick, int zstdLevel) {
   }
   raw.putArray(std::span<const std::uint16_t>(brick.attributes));
 
-  compressed.resize(ZSTD_compressBound(raw.size()));
+  payload.resize(ZSTD_compressBound(raw.size()));  // uninitialized: no memset of the bound
   ZSTD_CCtx* context = threadCompressor();
   const std::size_t n =
-      ZSTD_compressCCtx(context, compressed.data(), compressed.size(), raw.view().data(), raw.size(), zstdLevel);
+      ZSTD_compressCCtx(context, payload.data(), payload.size(), raw.view().data(), raw.size(), zstdLevel);
   FLIPSCOPE_CHECK(!ZSTD_isError(n), ZSTD_getErrorName(n));
-  return std::vector<std::byte>(compressed.begin(), compressed.begin() + std::ptrdiff_t(n));
+  payload.resize(n);
+}
+
+std::vector<std::byte> encodeBrick(const DecodedBrick& brick, int zstdLevel) {
+  UninitializedVector<std::byte> payload;
+  encodeBrickInto(brick, zstdLevel, payload);
+  return {payload.begin(), payload.end()};
 }
 
 namespace {

@@ -46,6 +46,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "core/UninitializedVector.h"
 #include "core/UpAxis.h"
 #include "preprocess/store/ParticleKind.h"
 #include "preprocess/store/PresenceOctree.h"
@@ -165,6 +166,9 @@ struct DecodedBrick {
 
 /// Payload codec (exposed for tests and the streaming benchmark).
 std::vector<std::byte> encodeBrick(const DecodedBrick& brick, int zstdLevel);
+/// encodeBrick into `payload`, whose capacity is reused: binning recycles a few payload
+/// buffers, where a fresh one per brick cost a first touch of every payload page.
+void encodeBrickInto(const DecodedBrick& brick, int zstdLevel, UninitializedVector<std::byte>& payload);
 /// Throws FileError naming `file` and `brickIndex` on any malformation; checks `expected`
 /// particle and cell counts, that every cell index is < cellsPerBrick and, with `hasKinds`,
 /// that every kind is < kParticleKindCount. Without `readAttributes`, a payload's attribute
