@@ -500,26 +500,28 @@ void binKeys(KeyBatch& keyBatch, const KeyGrid& grid, float min, float max, int 
   const std::size_t slots = 2 * std::size_t(tbb::this_task_arena::max_concurrency());
   std::vector<EncodedBrick> ring(slots);
   std::size_t next = 0;
-  tbb::parallel_pipeline(
-      slots, tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order, [&](tbb::flow_control& control) {
-               if (next == bricks.size()) control.stop();
-               return next++;
-             }) & tbb::make_filter<std::size_t, std::size_t>(tbb::filter_mode::parallel, [&](std::size_t k) {
-               const BrickParts& parts = bricks[k];
-               thread_local DecodedBrick brick;
-               thread_local DecodeScratch scratch;
-               decodeRun(keys.data(), parts, grid, fields, attribute, brick, scratch);
-               EncodedBrick& e = ring[k % slots];
-               e.kindCells = {};
-               for (ParticleKind kind : brick.kinds) ++e.kindCells[std::size_t(kind)];
-               e.coord = glm::uvec3(mortonDecode3(std::uint32_t(parts.code)));
-               e.particles = std::uint32_t(parts.keys());
-               e.cells = std::uint32_t(brick.cells.size());
-               encodeBrickInto(brick, zstdLevel, e.payload);
-               return k;
-             }) & tbb::make_filter<std::size_t, void>(tbb::filter_mode::serial_in_order, [&](std::size_t k) {
-               sink(ring[k % slots]);
-             }));
+  const auto eachBrick = [&](tbb::flow_control& control) {
+    if (next == bricks.size()) control.stop();
+    return next++;
+  };
+  const auto encode = [&](std::size_t k) {
+    const BrickParts& parts = bricks[k];
+    thread_local DecodedBrick brick;
+    thread_local DecodeScratch scratch;
+    decodeRun(keys.data(), parts, grid, fields, attribute, brick, scratch);
+    EncodedBrick& e = ring[k % slots];
+    e.kindCells = {};
+    for (ParticleKind kind : brick.kinds) ++e.kindCells[std::size_t(kind)];
+    e.coord = glm::uvec3(mortonDecode3(std::uint32_t(parts.code)));
+    e.particles = std::uint32_t(parts.keys());
+    e.cells = std::uint32_t(brick.cells.size());
+    encodeBrickInto(brick, zstdLevel, e.payload);
+    return k;
+  };
+  const auto write = [&](std::size_t k) { sink(ring[k % slots]); };
+  tbb::parallel_pipeline(slots, tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order, eachBrick) &
+                                    tbb::make_filter<std::size_t, std::size_t>(tbb::filter_mode::parallel, encode) &
+                                    tbb::make_filter<std::size_t, void>(tbb::filter_mode::serial_in_order, write));
 }
 
 }  // namespace flipscope::detail

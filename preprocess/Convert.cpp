@@ -686,12 +686,16 @@ class StoreDirectory {
       }
     }
     try {
+      // Registered and created as one step: a signal between the two left the lock file behind,
+      // and with it the directory of a store that never had a frame.
+      const DeferCleanupSignals step;
+      if (!BrickStore::exists(dir)) mLockCleanup = CleanupOnSignal(dir / kStoreLockName);
       mLock.emplace(dir);
+      stopPoint("lock");
     } catch (...) {
       if (mCreated) std::filesystem::remove(dir, ec);
       throw;
     }
-    if (!BrickStore::exists(dir)) mLockCleanup = CleanupOnSignal(dir / kStoreLockName);
   }
   ~StoreDirectory() {
     // No store left (a failed first convert) and no other writer: the lock file goes too, and

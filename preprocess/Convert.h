@@ -44,10 +44,11 @@
 // frames: incomplete) and the next convert removes the rest.
 //
 // Test hook: FLIPSCOPE_CONVERT_STOP="<point>:<n>:<KILL|INT|TERM|HUP>" raises that signal in the
-// converting thread the n-th time convert passes <point>: directory (created and locked), header
-// (store.fsh written), chunk (a chunk of particles read), spill (a spill file written to), brick
-// (a brick appended to the frame's temporary), frame-file (the frame file committed, not listed
-// yet), frame (listed in store.fsh).
+// converting thread the n-th time convert passes <point>: lock (the store's lock file created, in
+// the step that registers it for removal), directory (created and locked), header (store.fsh
+// written), chunk (a chunk of particles read), spill (a spill file written to), brick (a brick
+// appended to the frame's temporary, on the thread that appends it), frame-file (the frame file
+// committed, not listed yet), frame (listed in store.fsh).
 #pragma once
 
 #include <cstdint>

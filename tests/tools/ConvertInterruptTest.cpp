@@ -212,13 +212,24 @@ class ConvertInterrupt : public ::testing::Test {
     const std::string name = signal == SIGINT ? "INT" : "KILL";
     const int bricks1 = bricksOfFrame1();
     ASSERT_GT(bricks1, 2);
-    // Each a different state: the directory alone; store.fsh without frames; frame 1 being read;
+    // Each a different state: the lock file being created; the directory alone; store.fsh
+    // without frames; frame 1 being read;
     // its temporary being written; committed but not listed; listed; frame 2 read in core; spill
     // files written; frame 2's temporary written while its spill files exist; committed but not
     // listed; the last frame listed.
-    const std::vector<std::string> points = {
-        "directory:1", "header:1", "chunk:1", "brick:2", "frame-file:1", "frame:1", "chunk:12", "spill:1",
-        "spill:7", "brick:" + std::to_string(bricks1 + 2), "frame-file:2", "frame:3"};
+    const std::vector<std::string> points = {"lock:1",
+                                             "directory:1",
+                                             "header:1",
+                                             "chunk:1",
+                                             "brick:2",
+                                             "frame-file:1",
+                                             "frame:1",
+                                             "chunk:12",
+                                             "spill:1",
+                                             "spill:7",
+                                             "brick:" + std::to_string(bricks1 + 2),
+                                             "frame-file:2",
+                                             "frame:3"};
     int index = 0;
     for (const auto& point : points) {
       const fs::path store = dir / ("s" + std::to_string(index++));
