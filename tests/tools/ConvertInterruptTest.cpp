@@ -213,10 +213,9 @@ class ConvertInterrupt : public ::testing::Test {
     const int bricks1 = bricksOfFrame1();
     ASSERT_GT(bricks1, 2);
     // Each a different state: the lock file being created; the directory alone; store.fsh
-    // without frames; frame 1 being read;
-    // its temporary being written; committed but not listed; listed; frame 2 read in core; spill
-    // files written; frame 2's temporary written while its spill files exist; committed but not
-    // listed; the last frame listed.
+    // without frames; frame 1 being read; its temporary being written; committed but not listed;
+    // listed; frame 2 read in core; spill files written; frame 2's temporary written while its
+    // spill files exist; committed but not listed; the last frame listed.
     const std::vector<std::string> points = {"lock:1",
                                              "directory:1",
                                              "header:1",
