@@ -129,16 +129,15 @@ TEST_P(TiledCpuRaycasterScenes, EqualsTheReferenceColdAndWarm) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    RandomScenes, TiledCpuRaycasterScenes,
-    ::testing::Values(SceneCase{1, 1.0f, 0.0f, false, 0.0f, FoamMode::Keep},
-                      SceneCase{2, 1.4f, 0.3f, false, 0.0f, FoamMode::Keep},
-                      SceneCase{3, 0.9f, 0.25f, true, 0.0f, FoamMode::Keep},
-                      SceneCase{4, 1.2f, 0.3f, true, 24.0f, FoamMode::Remove},
-                      SceneCase{5, 1.0f, 0.3f, false, 64.0f, FoamMode::Volume},
-                      SceneCase{6, 1.9f, 0.0f, true, 64.0f, FoamMode::Volume},
-                      // Reach 4, beyond the defaults (1 and 2): slabs of 81 cells.
-                      SceneCase{7, 3.6f, 0.3f, true, 0.0f, FoamMode::Keep}));
+INSTANTIATE_TEST_SUITE_P(RandomScenes, TiledCpuRaycasterScenes,
+                         ::testing::Values(SceneCase{1, 1.0f, 0.0f, false, 0.0f, FoamMode::Keep},
+                                           SceneCase{2, 1.4f, 0.3f, false, 0.0f, FoamMode::Keep},
+                                           SceneCase{3, 0.9f, 0.25f, true, 0.0f, FoamMode::Keep},
+                                           SceneCase{4, 1.2f, 0.3f, true, 24.0f, FoamMode::Remove},
+                                           SceneCase{5, 1.0f, 0.3f, false, 64.0f, FoamMode::Volume},
+                                           SceneCase{6, 1.9f, 0.0f, true, 64.0f, FoamMode::Volume},
+                                           // Reach 4, beyond the other scenes' 1 and 2: slabs of 81 cells.
+                                           SceneCase{7, 3.6f, 0.3f, true, 0.0f, FoamMode::Keep}));
 
 }  // namespace
 }  // namespace flipscope
