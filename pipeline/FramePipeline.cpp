@@ -135,7 +135,8 @@ void FramePipeline::init(std::shared_ptr<BrickSource> source,
   else
     mScreen = std::make_unique<CpuScreenDevice>();
   ScreenFrame frame{};
-  frame.size = glm::uvec4(settings.width, settings.height, 0, 0);
+  frame.width = settings.width;
+  frame.height = settings.height;
   mScreen->setFrame(frame);
   mStages = std::make_unique<Stages>();
   Stages& s = *mStages;
@@ -176,11 +177,14 @@ ScreenFrame FramePipeline::screenFrame(const Camera& camera) const {
   const StoreHeader& header = mRenderer->source().header();
   const double tanHalf = std::tan(glm::radians(camera.fovYDegrees) * 0.5);
   ScreenFrame f{};
-  f.size = glm::uvec4(settings.width, settings.height, 0, 0);
-  f.forward = glm::vec4(glm::vec3(camera.forward()), float(tanHalf));
-  f.right = glm::vec4(glm::vec3(camera.right()), float(settings.width) / float(settings.height));
+  f.forward = glm::vec4(glm::vec3(camera.forward()), 0.0f);
+  f.right = glm::vec4(glm::vec3(camera.right()), 0.0f);
   f.up = glm::vec4(glm::vec3(camera.trueUp()), 0.0f);
   f.worldUp = glm::vec4(glm::vec3(glm::normalize(mSurface.up)), 0.0f);
+  f.width = settings.width;
+  f.height = settings.height;
+  f.tanHalfFovY = float(tanHalf);
+  f.aspect = float(settings.width) / float(settings.height);
   f.focalPixels = float(settings.height / (2.0 * tanHalf));
   f.particleRadius = float(settings.radius * header.cellSize);
   f.cellSize = float(header.cellSize);

@@ -22,15 +22,17 @@ struct RaycastPoolAccess {
 
   uvec2 rcNode(uint node) const { return pool->nodes[node]; }
   uint rcPage(uint brickIndex) const { return pool->pageTable[brickIndex]; }
-  uvec4 rcSubBrick(uint slot, uint subBrick) const { return pool->subBricks[std::size_t(slot) * P.brick.w + subBrick]; }
-  uint rcMipWord(uint slot, uint word) const { return pool->mipWords[std::size_t(slot) * P.pool.x + word]; }
+  uvec4 rcSubBrick(uint slot, uint subBrick) const {
+    return pool->subBricks[std::size_t(slot) * P.subBricksPerSlot + subBrick];
+  }
+  uint rcMipWord(uint slot, uint word) const { return pool->mipWords[std::size_t(slot) * P.mipWordsPerSlot + word]; }
   uint rcAttributeBase(uint slot, uint subBrick) const {
-    return pool->attributeBases[std::size_t(slot) * P.brick.w + subBrick];
+    return pool->attributeBases[std::size_t(slot) * P.subBricksPerSlot + subBrick];
   }
   uint rcAttribute(uint index) const { return pool->attributes[index]; }
   void rcRequest(uint brickIndex) const { requestFlags[brickIndex].store(1, std::memory_order_relaxed); }
   uvec4 rcFoamSubBrick(uint slot, uint subBrick) const {
-    return pool->foamBits[std::size_t(slot) * P.brick.w + subBrick];
+    return pool->foamBits[std::size_t(slot) * P.subBricksPerSlot + subBrick];
   }
   uint rcFoamOccupancy(uint slot, uint word) const {
     return pool->foamOccupancy[std::size_t(slot) * pool->layout.foamOccupancyWords() + word];
@@ -53,8 +55,12 @@ struct FoamKernel {
   FoamClassifyParams FP;
   const CpuRaycaster::Pool* pool;
 
-  uvec4 fcSubBrick(uint slot, uint subBrick) const { return pool->subBricks[std::size_t(slot) * FP.brick.z + subBrick]; }
-  uvec4 fcFoam(uint slot, uint subBrick) const { return pool->foamBits[std::size_t(slot) * FP.brick.z + subBrick]; }
+  uvec4 fcSubBrick(uint slot, uint subBrick) const {
+    return pool->subBricks[std::size_t(slot) * FP.subBricksPerSlot + subBrick];
+  }
+  uvec4 fcFoam(uint slot, uint subBrick) const {
+    return pool->foamBits[std::size_t(slot) * FP.subBricksPerSlot + subBrick];
+  }
 
 #include "raycast/glsl/FoamClassify.glsl"
 };

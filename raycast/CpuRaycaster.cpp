@@ -87,8 +87,8 @@ void CpuRaycaster::uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset
 
 void CpuRaycaster::classifyFoam(std::span<const std::uint32_t> slots, const FoamClassifyParams& params) {
   const PoolLayout& layout = mPool.layout;
-  FLIPSCOPE_CHECK(layout.foam && params.brick.z == layout.subBricksPerSlot &&
-                  params.brick.w == slots.size() * layout.subBricksPerSlot);
+  FLIPSCOPE_CHECK(layout.foam && params.subBricksPerSlot == layout.subBricksPerSlot &&
+                  params.batchSubBricks == slots.size() * layout.subBricksPerSlot);
   // In place, as on the GPU: a sub-brick's classification reads no foam bits but its own.
   timedClassify(slots, params, [&](std::uint32_t slot) {
     glsl::FoamKernel kernel{params, &mPool};
@@ -134,7 +134,7 @@ std::span<const RayHit> CpuRaycaster::hits() {
 
 std::vector<std::uint32_t> CpuRaycaster::timedPass(
     const RaycastParams& params, const std::function<void(const glsl::RaycastPoolAccess& access)>& pass) {
-  FLIPSCOPE_CHECK(params.image.x == mWidth && params.image.y == mHeight);
+  FLIPSCOPE_CHECK(params.width == mWidth && params.height == mHeight);
   const auto start = std::chrono::steady_clock::now();
   const std::size_t brickCount = mPool.pageTable.size();
   std::unique_ptr<std::atomic<std::uint8_t>[]> flags(

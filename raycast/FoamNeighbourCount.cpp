@@ -59,13 +59,13 @@ void setFoamBit(glm::uvec4* foam, glm::uvec3 dims, std::uint32_t x, std::uint32_
 
 void classifyBrickFoam(const glm::uvec4* subBricks, glm::uvec4* foam, const FoamClassifyParams& params,
                        FoamNeighbourScratch& scratch) {
-  if (params.sphere.z < 0.5f) return;  // the uploaded bits as they are
-  const std::uint32_t brickSize = params.brick.x, overlap = params.brick.y;
+  if (params.classify == 0u) return;  // the uploaded bits as they are
+  const std::uint32_t brickSize = params.brickSize, overlap = params.overlap;
   const glm::uvec3 dims = glsl::bitBrickSubBrickDims(brickSize, overlap);
-  FLIPSCOPE_CHECK(params.brick.z == dims.x * dims.y * dims.z, params.brick.z << " sub-bricks");
-  const float radius = params.sphere.x;
+  FLIPSCOPE_CHECK(params.subBricksPerSlot == dims.x * dims.y * dims.z, params.subBricksPerSlot << " sub-bricks");
+  const float radius = params.radius;
   const int reach = int(std::floor(radius));
-  const float needed = params.sphere.y * float(glsl::FoamKernel{params, nullptr}.fcNeighbourhoodSize(radius));
+  const float needed = params.threshold * float(glsl::FoamKernel{params, nullptr}.fcNeighbourhoodSize(radius));
   // Every set cell of the sub-bricks, which may reach past the stored cells: the cells to
   // classify. Rows of a multiple of kLanes, zero beyond the sub-bricks.
   const glm::ivec3 extent(dims * glm::uvec3(4, 4, 8));

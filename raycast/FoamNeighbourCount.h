@@ -23,7 +23,7 @@ struct FoamNeighbourScratch {
   std::vector<std::int32_t> offsets;
 };
 
-/// fcClassify of every sub-brick of one brick: `subBricks` are its bits (params.brick.z of them),
+/// fcClassify of every sub-brick of one brick: `subBricks` are its bits (params.subBricksPerSlot of them),
 /// `foam` its foam bits as uploaded, replaced by the classified ones. Equal to the reference's
 /// fcClassify bit for bit (tests/raycast/FoamNeighbourCountTest.cpp).
 void classifyBrickFoam(const glm::uvec4* subBricks, glm::uvec4* foam, const FoamClassifyParams& params,

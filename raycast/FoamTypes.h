@@ -12,5 +12,10 @@ namespace flipscope::glsl {
 
 namespace flipscope {
 using glsl::FoamClassifyParams;
-static_assert(sizeof(FoamClassifyParams) == 2 * 16 && offsetof(FoamClassifyParams, sphere) == 16);
+static_assert(sizeof(FoamClassifyParams) == 2 * 16);
+static_assert(offsetof(FoamClassifyParams, brickSize) == 0 && offsetof(FoamClassifyParams, overlap) == 4 &&
+              offsetof(FoamClassifyParams, subBricksPerSlot) == 8 &&
+              offsetof(FoamClassifyParams, batchSubBricks) == 12);
+static_assert(offsetof(FoamClassifyParams, radius) == 16 && offsetof(FoamClassifyParams, threshold) == 20 &&
+              offsetof(FoamClassifyParams, classify) == 24 && offsetof(FoamClassifyParams, unused0) == 28);
 }  // namespace flipscope

@@ -129,21 +129,34 @@ RaycastParams FrameRenderer::params(const Camera& camera, const FrameIndex& fram
   RaycastParams p{};
   const glm::dvec3 eye = (camera.eye - h.origin) / h.cellSize;
   p.eye = glm::vec4(glm::vec3(eye), 0.0f);
-  p.forward = glm::vec4(glm::vec3(camera.forward()), float(std::tan(glm::radians(camera.fovYDegrees) * 0.5)));
-  p.right = glm::vec4(glm::vec3(camera.right()), float(mSettings.width) / float(mSettings.height));
-  p.up = glm::vec4(glm::vec3(camera.trueUp()), float(h.cellSize));
-  p.image = glm::uvec4(mSettings.width, mSettings.height, std::uint32_t(frame.frame), 0);
-  p.grid = glm::uvec4(h.brickGrid, h.brickSize);
-  p.brick = glm::uvec4(mOverlap, mReach, frame.octree.levels, layout.subBricksPerSlot);
-  p.pool = glm::uvec4(layout.mipWordsPerSlot, layout.attributes ? 1u : 0u, std::uint32_t(frame.bricks.size()),
-                      layout.mipLevels);
-  p.sphere = glm::vec4(mSettings.radius, mSettings.jitter, 0.0f, mSettings.thicknessSaturationCells);
+  p.forward = glm::vec4(glm::vec3(camera.forward()), 0.0f);
+  p.right = glm::vec4(glm::vec3(camera.right()), 0.0f);
+  p.up = glm::vec4(glm::vec3(camera.trueUp()), 0.0f);
+  p.bricksPerAxis = glm::uvec4(h.brickGrid, 0u);
+  p.tanHalfFovY = float(std::tan(glm::radians(camera.fovYDegrees) * 0.5));
+  p.aspect = float(mSettings.width) / float(mSettings.height);
+  p.cellSize = float(h.cellSize);
+  p.width = mSettings.width;
+  p.height = mSettings.height;
+  p.timeStep = std::uint32_t(frame.frame);
+  p.brickSize = h.brickSize;
+  p.overlap = mOverlap;
+  p.reach = mReach;
+  p.octreeLevels = frame.octree.levels;
+  p.subBricksPerSlot = layout.subBricksPerSlot;
+  p.mipWordsPerSlot = layout.mipWordsPerSlot;
+  p.attributes = layout.attributes ? 1u : 0u;
+  p.frameBricks = std::uint32_t(frame.bricks.size());
+  p.mipLevelCount = layout.mipLevels;
+  p.radius = mSettings.radius;
+  p.maxJitter = mSettings.jitter;
+  p.thicknessBestEffort = 0u;
+  p.thicknessSaturationCells = mSettings.thicknessSaturationCells;
   const FoamSettings& foam = mSettings.foam;
-  p.foam = glm::uvec4(foam.mode == FoamMode::Keep     ? 0u
-                      : foam.mode == FoamMode::Remove ? kFoamSkip
-                                                      : kFoamSkip | kFoamVolume,
-                      0u, 0u, 0u);
-  p.volume = glm::vec4(foam.step, foam.extinction, foam.opacityStop, 0.0f);
+  p.foamFlags = foam.mode == FoamMode::Keep ? 0u : foam.mode == FoamMode::Remove ? kFoamSkip : kFoamSkip | kFoamVolume;
+  p.foamStep = foam.step;
+  p.foamExtinction = foam.extinction;
+  p.foamOpacityStop = foam.opacityStop;
   FLIPSCOPE_CHECK(layout.mipLevels <= kMaxMipLevels, "mip levels " << layout.mipLevels);
   for (std::uint32_t level = 1; level <= layout.mipLevels; ++level)
     p.mipLevels[level - 1] = glm::uvec4(bitBrickMipDims(level, h.brickSize, mOverlap),
@@ -154,9 +167,13 @@ RaycastParams FrameRenderer::params(const Camera& camera, const FrameIndex& fram
 FoamClassifyParams FrameRenderer::foamParams(std::size_t slots) const {
   const PoolLayout& layout = mPool.layout();
   FoamClassifyParams p{};
-  p.brick = glm::uvec4(layout.brickSize, mOverlap, layout.subBricksPerSlot,
-                       std::uint32_t(slots * layout.subBricksPerSlot));
-  p.sphere = glm::vec4(mSettings.radius, mSettings.foam.threshold, mSettings.foam.classifies() ? 1.0f : 0.0f, 0.0f);
+  p.brickSize = layout.brickSize;
+  p.overlap = mOverlap;
+  p.subBricksPerSlot = layout.subBricksPerSlot;
+  p.batchSubBricks = std::uint32_t(slots * layout.subBricksPerSlot);
+  p.radius = mSettings.radius;
+  p.threshold = mSettings.foam.threshold;
+  p.classify = mSettings.foam.classifies() ? 1u : 0u;
   return p;
 }
 
@@ -353,7 +370,7 @@ void FrameRenderer::upload(std::vector<std::shared_ptr<const ConvertedBrick>> br
       // The pool cannot hold what this frame needs at once: thickness behind a hit becomes
       // best effort, so the bricks of hits and of thickness marches cannot evict each other
       // forever. Hits stay exact.
-      a.params.sphere.z = 1.0f;
+      a.params.thicknessBestEffort = 1u;
     }
     if (!placement) break;  // the pool holds this pass's bricks only: the rest next pass
     mDevice->uploadBrick(placement->slot, placement->attributeOffset, *brick);

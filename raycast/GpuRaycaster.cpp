@@ -120,8 +120,8 @@ void GpuRaycaster::uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset
 }
 
 void GpuRaycaster::classifyFoam(std::span<const std::uint32_t> slots, const FoamClassifyParams& params) {
-  FLIPSCOPE_CHECK(mLayout.foam && params.brick.z == mLayout.subBricksPerSlot &&
-                  params.brick.w == slots.size() * mLayout.subBricksPerSlot);
+  FLIPSCOPE_CHECK(mLayout.foam && params.subBricksPerSlot == mLayout.subBricksPerSlot &&
+                  params.batchSubBricks == slots.size() * mLayout.subBricksPerSlot);
   mLastClassifyMs = 0;
   if (slots.empty()) return;
   if (!mFoamProgram.id()) {
@@ -139,7 +139,7 @@ void GpuRaycaster::classifyFoam(std::span<const std::uint32_t> slots, const Foam
   for (std::size_t first = 0; first < slots.size(); first += kMaxChunk) {
     const std::size_t count = std::min(kMaxChunk, slots.size() - first);
     FoamClassifyParams p = params;
-    p.brick.w = std::uint32_t(count) * mLayout.subBricksPerSlot;
+    p.batchSubBricks = std::uint32_t(count) * mLayout.subBricksPerSlot;
     mFoamParams.upload(0, &p, sizeof(p));
     mBatch.upload(0, slots.data() + first, count * 4);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_UNIFORM_BARRIER_BIT);
@@ -148,7 +148,7 @@ void GpuRaycaster::classifyFoam(std::span<const std::uint32_t> slots, const Foam
     mFoam.bindBase(GL_SHADER_STORAGE_BUFFER, kFoam);
     mBatch.bindBase(GL_SHADER_STORAGE_BUFFER, kBatch);
     mFoamOccupancy.bindBase(GL_SHADER_STORAGE_BUFFER, kFoamOccupancy);
-    if (params.sphere.z > 0.5f) {
+    if (params.classify != 0u) {
       mFoamProgram.use();
       mFoamProgram.dispatch((mLayout.subBricksPerSlot + kFoamGroupSize - 1) / kFoamGroupSize, std::uint32_t(count), 1);
       glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -180,7 +180,7 @@ void GpuRaycaster::beginImage(std::uint32_t width, std::uint32_t height) {
 }
 
 std::vector<std::uint32_t> GpuRaycaster::trace(const RaycastParams& params) {
-  FLIPSCOPE_CHECK(params.image.x == mWidth && params.image.y == mHeight);
+  FLIPSCOPE_CHECK(params.width == mWidth && params.height == mHeight);
   mParams.upload(0, &params, sizeof(params));
   const std::uint32_t zero = 0;
   mRequests.upload(0, &zero, 4);

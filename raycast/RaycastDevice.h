@@ -40,8 +40,8 @@ class RaycastDevice {
   /// With a foam pool (PoolLayout::foam) its foam bit-brick becomes brick.foamKinds, or zeros.
   virtual void uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset, const ConvertedBrick& brick) = 0;
   /// Foam classification (§3.5, raycast/glsl/FoamClassify.glsl) of the bricks uploaded into
-  /// `slots`: their foam bit-bricks become the uploaded ones plus (params.sphere.z = 1) the
-  /// classified cells, then their foam occupancy is built. Needs a foam pool; params.brick.w must
+  /// `slots`: their foam bit-bricks become the uploaded ones plus (params.classify = 1u) the
+  /// classified cells, then their foam occupancy is built. Needs a foam pool; params.batchSubBricks must
   /// be slots.size() * the sub-bricks per slot. Every upload into a foam pool needs it before
   /// the next trace.
   virtual void classifyFoam(std::span<const std::uint32_t> slots, const FoamClassifyParams& params) = 0;

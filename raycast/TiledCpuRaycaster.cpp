@@ -62,10 +62,10 @@ struct TiledRaycastKernel : RaycastPoolAccess {
   TiledRaycastKernel(const RaycastPoolAccess& access, JitterCache& jitter)
       : RaycastPoolAccess(access),
         jitter(&jitter),
-        B(int(P.grid.w)),
-        k(int(P.brick.y)),
-        overlap(int(P.brick.x)),
-        subBrickDims(bitBrickSubBrickDims(P.grid.w, P.brick.x)) {}
+        B(int(P.brickSize)),
+        k(int(P.reach)),
+        overlap(int(P.overlap)),
+        subBrickDims(bitBrickSubBrickDims(P.brickSize, P.overlap)) {}
 
   JitterCache* jitter;
   int B, k, overlap;
@@ -75,11 +75,11 @@ struct TiledRaycastKernel : RaycastPoolAccess {
   /// the sphere cells without the foam cells whenever the pool has foam (FrameRenderer sets
   /// kFoamSkip then).
   uint rcLiquidHalfCount(uint slot, uvec2 h) {
-    if (pool->layout.foam && (P.foam.x & kFoamSkip) == 0u) return rcLiquidHalfCountOfBits(slot, h);
-    return pool->halfCounts[(std::size_t(slot) * P.brick.w + h.x) * 4u + h.y];
+    if (pool->layout.foam && (P.foamFlags & kFoamSkip) == 0u) return rcLiquidHalfCountOfBits(slot, h);
+    return pool->halfCounts[(std::size_t(slot) * P.subBricksPerSlot + h.x) * 4u + h.y];
   }
   uint rcFoamHalfCount(uint slot, uvec2 h) {
-    return pool->halfCounts[(std::size_t(slot) * P.brick.w + h.x) * 4u + 2u + h.y];
+    return pool->halfCounts[(std::size_t(slot) * P.subBricksPerSlot + h.x) * 4u + 2u + h.y];
   }
 
   /// Tests the sphere of brick-local cell (x, y, z) (in [-n, B + n)) of the slot whose bits
@@ -95,7 +95,7 @@ struct TiledRaycastKernel : RaycastPoolAccess {
     if (foam) word &= ~(&foam[subBrick].x)[bit >> 5u];
     if (((word >> (bit & 31u)) & 1u) == 0u) return;
     vec3 centre = vec3(float(x) + 0.5f, float(y) + 0.5f, float(z) + 0.5f);
-    if (P.sphere.y > 0.0f) centre += jitter->offset(brickCell + uvec3(uint(x), uint(y), uint(z)));
+    if (P.maxJitter > 0.0f) centre += jitter->offset(brickCell + uvec3(uint(x), uint(y), uint(z)));
     nearest = rcNearerSphere(nearest, ivec3(x, y, z), centre, p, t, dir);
   }
 
@@ -114,9 +114,9 @@ struct TiledRaycastKernel : RaycastPoolAccess {
     const uvec3 brickCell = brick * uvec3(uint(B));
     const vec3 o = eye - vec3(brickCell);
     const vec3 invDir = rcSafeInverse(dir);
-    const std::size_t first = std::size_t(slot) * P.brick.w;
+    const std::size_t first = std::size_t(slot) * P.subBricksPerSlot;
     const uvec4* bits = pool->subBricks.data() + first;
-    const uvec4* foam = (P.foam.x & kFoamSkip) != 0u ? pool->foamBits.data() + first : nullptr;
+    const uvec4* foam = (P.foamFlags & kFoamSkip) != 0u ? pool->foamBits.data() + first : nullptr;
     // The slot's NearSphereMask, when it holds the spheres this march tests (without the foam
     // cells exactly when they are skipped) for this reach.
     const bool maskHolds = (!pool->layout.foam || foam) && uint(k) == pool->layout.reach;
@@ -126,7 +126,7 @@ struct TiledRaycastKernel : RaycastPoolAccess {
     // Empty space to skip (ClearDistance): with the mask, cubes of 4^3-cell groups with no sphere
     // near; else, and with the foam volume (whose cells the mask leaves out but the ray
     // gathers), cubes of clear level-1 mip blocks (4x4x8 stored cells, foam cells included).
-    const bool groups = near && (P.foam.x & kFoamVolume) == 0u;
+    const bool groups = near && (P.foamFlags & kFoamVolume) == 0u;
     const int groupsPerEdge = B / int(kNearGroupCells);
     const std::uint8_t* distances =
         groups ? pool->nearDistances.data() + std::size_t(slot) * nearSphereGroupCount(uint(B))
@@ -223,7 +223,7 @@ struct TiledRaycastKernel : RaycastPoolAccess {
         }
       }
       const float cellExit = std::min(std::min(exit[0], exit[1]), exit[2]);
-      if ((P.foam.x & kFoamVolume) != 0u) {
+      if ((P.foamFlags & kFoamVolume) != 0u) {
         ray.foam = rcAccumulateFoam(ray.foam, slot, o, dir, t, min(cellExit, nearest.t));
         if (rcFoamOpaque(ray)) return;
       }
@@ -287,7 +287,7 @@ void TiledCpuRaycaster::classifyFoam(std::span<const std::uint32_t> slots, const
 
 std::vector<std::uint32_t> TiledCpuRaycaster::trace(const RaycastParams& params) {
   return timedPass(params, [&](const glsl::RaycastPoolAccess& access) {
-    tbb::enumerable_thread_specific<glsl::JitterCache> caches(params.image.z, params.sphere.y);
+    tbb::enumerable_thread_specific<glsl::JitterCache> caches(params.timeStep, params.maxJitter);
     const tbb::blocked_range2d<std::uint32_t> tiles(0, mHeight, kTileSize, 0, mWidth, kTileSize);
     tbb::parallel_for(tiles, [&](const tbb::blocked_range2d<std::uint32_t>& tile) {
       glsl::TiledRaycastKernel kernel(access, caches.local());

@@ -21,8 +21,8 @@ struct CompactRofKernel {
   const vec2* images[3] = {};
 
   vec4 ssLoad(uint image, ivec2 p) const {
-    const ivec2 q = clamp(p, ivec2(0), ivec2(int(F.size.x) - 1, int(F.size.y) - 1));
-    const vec2 v = images[image][uint(q.y) * F.size.x + uint(q.x)];
+    const ivec2 q = clamp(p, ivec2(0), ivec2(int(F.width) - 1, int(F.height) - 1));
+    const vec2 v = images[image][uint(q.y) * F.width + uint(q.x)];
     return vec4(v.x, v.y, 0.0f, 0.0f);
   }
 #include "smoothing/glsl/ScreenMath.glsl"
@@ -38,7 +38,7 @@ constexpr std::uint32_t kBandRows = 16;  ///< rows of the bands a thread iterate
 void CpuRofIterations::run(CpuScreenDevice& device, const glsl::RofParams& params, int iterations,
                            ScreenImage domain, ScreenImage div) {
   const ScreenFrame& frame = device.frame();
-  const std::uint32_t width = frame.size.x, height = frame.size.y;
+  const std::uint32_t width = frame.width, height = frame.height;
   const std::size_t n = std::size_t(width) * height;
   const auto domainPixels = device.pixels(domain);
   FLIPSCOPE_CHECK(domainPixels.size() == n);

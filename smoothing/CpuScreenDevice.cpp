@@ -14,11 +14,12 @@ std::string CpuScreenDevice::name() const {
 }
 
 void CpuScreenDevice::setFrame(const ScreenFrame& frame) {
-  const bool resized = frame.size.x != mFrame.size.x || frame.size.y != mFrame.size.y;
+  const bool resized = frame.width != mFrame.width || frame.height != mFrame.height;
   mFrame = frame;
   if (!resized) return;
   for (Image& image : mImages)
-    if (image.perPixel && !image.adopted) image.data.assign(std::size_t(frame.size.x) * frame.size.y * image.perPixel, glm::vec4(0));
+    if (image.perPixel && !image.adopted)
+      image.data.assign(std::size_t(frame.width) * frame.height * image.perPixel, glm::vec4(0));
 }
 
 ScreenImage CpuScreenDevice::createFrameImage(std::uint32_t perPixel) {

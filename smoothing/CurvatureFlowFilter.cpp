@@ -61,8 +61,8 @@ class CurvatureFlowFilter : public SurfaceFilter {
     if (!mLinks) mLinks = device.createFrameImage();
     const ScreenFrame& frame = device.frame();
     glsl::CurvatureFlowParams params{};
-    params.cx = 2.0f * frame.forward.w * frame.right.w / float(frame.size.x);
-    params.cy = 2.0f * frame.forward.w / float(frame.size.y);
+    params.cx = 2.0f * frame.tanHalfFovY * frame.aspect / float(frame.width);
+    params.cy = 2.0f * frame.tanHalfFovY / float(frame.height);
     params.stepPerDepth = mOptions.strength * params.cx * params.cy / (params.cx + params.cy);
     params.jumpBase = kJumpRadii * frame.particleRadius;
     params.jumpPerDepth = kJumpFootprints * std::max(params.cx, params.cy);

@@ -20,13 +20,13 @@ GpuScreenDevice::GpuScreenDevice(std::string name)
 GpuScreenDevice::~GpuScreenDevice() = default;
 
 void GpuScreenDevice::setFrame(const ScreenFrame& frame) {
-  const bool resized = frame.size.x != mFrame.size.x || frame.size.y != mFrame.size.y;
+  const bool resized = frame.width != mFrame.width || frame.height != mFrame.height;
   mFrame = frame;
   mFrameBlock.upload(0, &mFrame, sizeof(ScreenFrame));
   if (!resized) return;
   for (Image& image : mImages) {
     if (!image.perPixel) continue;
-    image.elements = std::size_t(frame.size.x) * frame.size.y * image.perPixel;
+    image.elements = std::size_t(frame.width) * frame.height * image.perPixel;
     if (!image.adopted) image.owned = makeBuffer(image.elements);
   }
 }

@@ -51,8 +51,8 @@ class ScreenDevice {
   /// the size changes.
   virtual void setFrame(const ScreenFrame& frame) = 0;
   const ScreenFrame& frame() const { return mFrame; }
-  std::uint32_t width() const { return mFrame.size.x; }
-  std::uint32_t height() const { return mFrame.size.y; }
+  std::uint32_t width() const { return mFrame.width; }
+  std::uint32_t height() const { return mFrame.height; }
 
   /// A frame-sized image of `perPixel` vec4 per pixel.
   virtual ScreenImage createFrameImage(std::uint32_t perPixel = 1) = 0;

@@ -15,7 +15,11 @@ using glsl::ScreenFrame;
 using glsl::ScreenPair;
 
 static_assert(sizeof(ScreenFrame) == 6 * 16);
-static_assert(offsetof(ScreenFrame, forward) == 16 && offsetof(ScreenFrame, worldUp) == 64 &&
-              offsetof(ScreenFrame, focalPixels) == 80 && offsetof(ScreenFrame, unused0) == 92);
+static_assert(offsetof(ScreenFrame, forward) == 0 && offsetof(ScreenFrame, right) == 16 &&
+              offsetof(ScreenFrame, up) == 32 && offsetof(ScreenFrame, worldUp) == 48);
+static_assert(offsetof(ScreenFrame, width) == 64 && offsetof(ScreenFrame, height) == 68 &&
+              offsetof(ScreenFrame, tanHalfFovY) == 72 && offsetof(ScreenFrame, aspect) == 76);
+static_assert(offsetof(ScreenFrame, focalPixels) == 80 && offsetof(ScreenFrame, particleRadius) == 84 &&
+              offsetof(ScreenFrame, cellSize) == 88 && offsetof(ScreenFrame, unused0) == 92);
 
 }  // namespace flipscope

@@ -9,7 +9,7 @@
 // volumetric foam in front of it, or along the ray on the background (§3.5). One pass reads the
 // hits (48 bytes a pixel) once for both.
 FS_FUNC ScreenPair gbufferHits(ivec2 p) {
-  uint i = uint(p.y) * F.size.x + uint(p.x);
+  uint i = uint(p.y) * F.width + uint(p.x);
   vec4 normal = ssLoadIndex(0u, 3u * i);
   vec4 ray = ssLoadIndex(0u, 3u * i + 1u);
   vec4 extra = ssLoadIndex(0u, 3u * i + 2u);

@@ -15,7 +15,7 @@ FS_FUNC float progressiveSrgb(float linear) {
 // (hit or miss), else the pixel shown before: a pending ray keeps the previous image until its
 // bricks arrive.
 FS_FUNC vec4 progressiveDisplay(ivec2 p) {
-  uint i = uint(p.y) * F.size.x + uint(p.x);
+  uint i = uint(p.y) * F.width + uint(p.x);
   vec4 ray = ssLoadIndex(0u, 3u * i + 1u);
   if (floatBitsToUint(ray.y) == kRayPending) return ssLoad(2u, p);
   vec4 c = ssLoad(1u, p);

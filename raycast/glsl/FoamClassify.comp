@@ -12,14 +12,14 @@ layout(std430, binding = 3) readonly buffer SubBrickBuffer { uvec4 subBricks[]; 
 layout(std430, binding = 10) buffer FoamBuffer { uvec4 foamBits[]; };
 layout(std430, binding = 11) readonly buffer BatchBuffer { uint batchSlots[]; };
 
-uvec4 fcSubBrick(uint slot, uint subBrick) { return subBricks[slot * FP.brick.z + subBrick]; }
-uvec4 fcFoam(uint slot, uint subBrick) { return foamBits[slot * FP.brick.z + subBrick]; }
+uvec4 fcSubBrick(uint slot, uint subBrick) { return subBricks[slot * FP.subBricksPerSlot + subBrick]; }
+uvec4 fcFoam(uint slot, uint subBrick) { return foamBits[slot * FP.subBricksPerSlot + subBrick]; }
 
 #include "FoamClassify.glsl"
 
 void main() {
   uint subBrick = gl_GlobalInvocationID.x;
-  if (subBrick >= FP.brick.z || gl_GlobalInvocationID.y >= FP.brick.w / FP.brick.z) return;
+  if (subBrick >= FP.subBricksPerSlot || gl_GlobalInvocationID.y >= FP.batchSubBricks / FP.subBricksPerSlot) return;
   uint slot = batchSlots[gl_GlobalInvocationID.y];
-  foamBits[slot * FP.brick.z + subBrick] = fcClassify(slot, subBrick);
+  foamBits[slot * FP.subBricksPerSlot + subBrick] = fcClassify(slot, subBrick);
 }

@@ -14,7 +14,7 @@
 // its sub-brick and returns its foam bits, which the includer writes over fcFoam of the same
 // sub-brick. An invocation writes only its own sub-brick and reads no foam bits but its own, so
 // a batch needs no atomics and no ordering. A cell's neighbourhood is every cell other than
-// itself whose centre lies within FP.sphere.x; cells beyond the stored border count as empty, so
+// itself whose centre lies within FP.radius; cells beyond the stored border count as empty, so
 // a cell is classified exactly when its neighbourhood lies within the border (FrameRenderer
 // sizes the border for that).
 
@@ -31,23 +31,23 @@ FS_FUNC uint fcNeighbourhoodSize(float radius) {
 
 // Whether stored cell `s` (brick-local cell + overlap) of `slot` is set; false beyond the stored cells.
 FS_FUNC bool fcStoredCellSet(uint slot, ivec3 s) {
-  int stored = int(FP.brick.x + 2u * FP.brick.y);
+  int stored = int(FP.brickSize + 2u * FP.overlap);
   if (s.x < 0 || s.y < 0 || s.z < 0 || s.x >= stored || s.y >= stored || s.z >= stored) return false;
-  ivec3 cell = s - ivec3(int(FP.brick.y));
-  return bitBrickBitSet(fcSubBrick(slot, bitBrickSubBrickIndex(cell, FP.brick.x, FP.brick.y)),
-                        bitBrickBitIndex(cell, FP.brick.y));
+  ivec3 cell = s - ivec3(int(FP.overlap));
+  return bitBrickBitSet(fcSubBrick(slot, bitBrickSubBrickIndex(cell, FP.brickSize, FP.overlap)),
+                        bitBrickBitIndex(cell, FP.overlap));
 }
 
-// The foam bits of sub-brick `subBrick` of `slot`: the uploaded ones, plus (FP.sphere.z = 1) every
-// set cell with fewer than FP.sphere.y times fcNeighbourhoodSize set neighbours.
+// The foam bits of sub-brick `subBrick` of `slot`: the uploaded ones, plus (FP.classify = 1u) every
+// set cell with fewer than FP.threshold times fcNeighbourhoodSize set neighbours.
 FS_FUNC uvec4 fcClassify(uint slot, uint subBrick) {
   uvec4 foam = fcFoam(slot, subBrick);
   uvec4 bits = fcSubBrick(slot, subBrick);
-  if (FP.sphere.z < 0.5f || (bits.x | bits.y | bits.z | bits.w) == 0u) return foam;
-  float radius = FP.sphere.x;
+  if (FP.classify == 0u || (bits.x | bits.y | bits.z | bits.w) == 0u) return foam;
+  float radius = FP.radius;
   int reach = int(floor(radius));
-  float needed = FP.sphere.y * float(fcNeighbourhoodSize(radius));
-  ivec3 origin = ivec3(bitBrickSubBrickCoord(subBrick, bitBrickSubBrickDims(FP.brick.x, FP.brick.y)) *
+  float needed = FP.threshold * float(fcNeighbourhoodSize(radius));
+  ivec3 origin = ivec3(bitBrickSubBrickCoord(subBrick, bitBrickSubBrickDims(FP.brickSize, FP.overlap)) *
                        uvec3(4u, 4u, 8u));
   for (uint bit = 0u; bit < 128u; bit++) {
     if (!bitBrickBitSet(bits, bit)) continue;
@@ -71,11 +71,11 @@ FS_FUNC uvec4 fcClassify(uint slot, uint subBrick) {
 // (Raycast.glsl, rcFoamDensity) is 0 everywhere in a sub-brick whose bit is clear. One
 // invocation per word, after fcClassify has written every sub-brick of the slot.
 FS_FUNC uint fcOccupancyWord(uint slot, uint word) {
-  uvec3 dims = bitBrickSubBrickDims(FP.brick.x, FP.brick.y);
+  uvec3 dims = bitBrickSubBrickDims(FP.brickSize, FP.overlap);
   uint occupancy = 0u;
   for (uint i = 0u; i < 32u; i++) {
     uint subBrick = word * 32u + i;
-    if (subBrick >= FP.brick.z) break;
+    if (subBrick >= FP.subBricksPerSlot) break;
     ivec3 c = ivec3(bitBrickSubBrickCoord(subBrick, dims));
     bool foam = false;
     for (int d = 0; d < 27 && !foam; d++) {

@@ -13,15 +13,15 @@ layout(std430, binding = 10) readonly buffer FoamBuffer { uvec4 foamBits[]; };
 layout(std430, binding = 11) readonly buffer BatchBuffer { uint batchSlots[]; };
 layout(std430, binding = 12) buffer FoamOccupancyBuffer { uint foamOccupancy[]; };
 
-uvec4 fcSubBrick(uint slot, uint subBrick) { return subBricks[slot * FP.brick.z + subBrick]; }
-uvec4 fcFoam(uint slot, uint subBrick) { return foamBits[slot * FP.brick.z + subBrick]; }
+uvec4 fcSubBrick(uint slot, uint subBrick) { return subBricks[slot * FP.subBricksPerSlot + subBrick]; }
+uvec4 fcFoam(uint slot, uint subBrick) { return foamBits[slot * FP.subBricksPerSlot + subBrick]; }
 
 #include "FoamClassify.glsl"
 
 void main() {
-  uint words = (FP.brick.z + 31u) / 32u;
+  uint words = (FP.subBricksPerSlot + 31u) / 32u;
   uint word = gl_GlobalInvocationID.x;
-  if (word >= words || gl_GlobalInvocationID.y >= FP.brick.w / FP.brick.z) return;
+  if (word >= words || gl_GlobalInvocationID.y >= FP.batchSubBricks / FP.subBricksPerSlot) return;
   uint slot = batchSlots[gl_GlobalInvocationID.y];
   foamOccupancy[slot * words + word] = fcOccupancyWord(slot, word);
 }

@@ -23,11 +23,11 @@ layout(std430, binding = 12) readonly buffer FoamOccupancyBuffer { uint foamOccu
 
 uvec2 rcNode(uint node) { return nodes[node]; }
 uint rcPage(uint brickIndex) { return pages[brickIndex]; }
-uvec4 rcSubBrick(uint slot, uint subBrick) { return subBricks[slot * P.brick.w + subBrick]; }
-uint rcMipWord(uint slot, uint word) { return mipWords[slot * P.pool.x + word]; }
-uint rcAttributeBase(uint slot, uint subBrick) { return attributeBases[slot * P.brick.w + subBrick]; }
-uvec4 rcFoamSubBrick(uint slot, uint subBrick) { return foamBits[slot * P.brick.w + subBrick]; }
-uint rcFoamOccupancy(uint slot, uint word) { return foamOccupancy[slot * ((P.brick.w + 31u) / 32u) + word]; }
+uvec4 rcSubBrick(uint slot, uint subBrick) { return subBricks[slot * P.subBricksPerSlot + subBrick]; }
+uint rcMipWord(uint slot, uint word) { return mipWords[slot * P.mipWordsPerSlot + word]; }
+uint rcAttributeBase(uint slot, uint subBrick) { return attributeBases[slot * P.subBricksPerSlot + subBrick]; }
+uvec4 rcFoamSubBrick(uint slot, uint subBrick) { return foamBits[slot * P.subBricksPerSlot + subBrick]; }
+uint rcFoamOccupancy(uint slot, uint word) { return foamOccupancy[slot * ((P.subBricksPerSlot + 31u) / 32u) + word]; }
 uint rcAttribute(uint index) { return (attributePairs[index >> 1u] >> ((index & 1u) * 16u)) & 0xffffu; }
 
 // The request buffer (§3.3): a brick is appended once per pass; overflow is dropped (the ray
@@ -53,8 +53,8 @@ void rcMarchBrick(inout RayHit result, uint slot, uvec3 brick, vec3 eye, vec3 di
 
 void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
-  if (pixel.x >= P.image.x || pixel.y >= P.image.y) return;
-  uint index = pixel.y * P.image.x + pixel.x;
+  if (pixel.x >= P.width || pixel.y >= P.height) return;
+  uint index = pixel.y * P.width + pixel.x;
   RayHit ray = hits[index];
   if (!rcNeedsPass(ray)) return;
   rcPass(pixel, ray);

@@ -25,8 +25,8 @@
 // A ray's RayHit is updated in place (FS_INOUT) from rcPass down to the march: on the CPU, a
 // copy of a struct just written field by field waits for those stores to reach the cache.
 //
-// Model. Every set cell of a bit-brick holds one sphere of radius P.sphere.x cells centred at the
-// cell centre plus the cell's jitter (§3.2.2). A sphere reaches cells at most k = P.brick.y away
+// Model. Every set cell of a bit-brick holds one sphere of radius P.radius cells centred at the
+// cell centre plus the cell's jitter (§3.2.2). A sphere reaches cells at most k = P.reach away
 // (k >= radius + jitter - 0.5), so the overlap border (n >= k) lets a brick alone answer for any
 // ray segment inside it, and a mip block whose bit is clear (dilation >= k) holds no sphere.
 //
@@ -44,8 +44,8 @@
 // remove` and `volume`). With kFoamVolume the ray also accumulates the foam in front of its hit
 // (or along its whole way through the bricks) at fixed steps, emission-absorption over a density
 // interpolated trilinearly between the 4^3 halves of the foam sub-bricks (Fig. 7); it ends as a
-// miss once the foam's opacity reaches P.volume.z. Regions a clear mip block skips hold no set
-// cell within the dilation, and no foam is gathered there.
+// miss once the foam's opacity reaches P.foamOpacityStop. Regions a clear mip block skips hold no
+// set cell within the dilation, and no foam is gathered there.
 
 // A small step past a box exit, so that point location lands in the next box.
 FS_FUNC float rcStepPast(float t) { return t + 1.0e-3f + abs(t) * 4.0e-7f; }
@@ -69,8 +69,8 @@ FS_FUNC vec2 rcBoxSpan(vec3 o, vec3 invDir, vec3 lo, vec3 hi) {
 
 // Unit direction of the ray through the centre of `pixel` (row 0 at the top).
 FS_FUNC vec3 rcCameraRay(uvec2 pixel) {
-  float sx = ((float(pixel.x) + 0.5f) * (2.0f / float(P.image.x)) - 1.0f) * P.forward.w * P.right.w;
-  float sy = (1.0f - (float(pixel.y) + 0.5f) * (2.0f / float(P.image.y))) * P.forward.w;
+  float sx = ((float(pixel.x) + 0.5f) * (2.0f / float(P.width)) - 1.0f) * P.tanHalfFovY * P.aspect;
+  float sy = (1.0f - (float(pixel.y) + 0.5f) * (2.0f / float(P.height))) * P.tanHalfFovY;
   vec3 f = vec3(P.forward.x, P.forward.y, P.forward.z);
   vec3 r = vec3(P.right.x, P.right.y, P.right.z);
   vec3 u = vec3(P.up.x, P.up.y, P.up.z);
@@ -80,17 +80,16 @@ FS_FUNC vec3 rcCameraRay(uvec2 pixel) {
 // Whether brick-local `cell` holds a sphere: set, and not foam when the pool's foam bit-bricks
 // are valid (kFoamSkip; §3.5: the surface pass skips foam cells).
 FS_FUNC bool rcSurfaceCellSet(uint slot, ivec3 cell) {
-  uint overlap = P.brick.x;
-  uint subBrick = bitBrickSubBrickIndex(cell, P.grid.w, overlap);
+  uint subBrick = bitBrickSubBrickIndex(cell, P.brickSize, P.overlap);
   uvec4 bits = rcSubBrick(slot, subBrick);
-  if ((P.foam.x & kFoamSkip) != 0u) bits = bits & ~rcFoamSubBrick(slot, subBrick);
-  return bitBrickBitSet(bits, bitBrickBitIndex(cell, overlap));
+  if ((P.foamFlags & kFoamSkip) != 0u) bits = bits & ~rcFoamSubBrick(slot, subBrick);
+  return bitBrickBitSet(bits, bitBrickBitIndex(cell, P.overlap));
 }
 
 // The 4^3 block `block` of a slot's stored cells (block b spans stored cells [4b, 4b + 4), the
 // halves of the sub-bricks; clamped to the stored blocks): x its sub-brick, y which half.
 FS_FUNC uvec2 rcHalfBlock(ivec3 block) {
-  uvec3 dims = bitBrickSubBrickDims(P.grid.w, P.brick.x);
+  uvec3 dims = bitBrickSubBrickDims(P.brickSize, P.overlap);
   uvec3 b = uvec3(clamp(block, ivec3(0), ivec3(int(dims.x) - 1, int(dims.y) - 1, int(2u * dims.z) - 1)));
   return uvec2(bitBrickSubBrickLinear(uvec3(b.x, b.y, b.z >> 1u), dims), b.z & 1u);
 }
@@ -98,7 +97,7 @@ FS_FUNC uvec2 rcHalfBlock(ivec3 block) {
 // The sphere cells (set, and not foam with kFoamSkip) of half block `h` (rcHalfBlock) of a slot.
 FS_FUNC uint rcLiquidHalfCountOfBits(uint slot, uvec2 h) {
   uvec4 bits = rcSubBrick(slot, h.x);
-  if ((P.foam.x & kFoamSkip) != 0u) bits = bits & ~rcFoamSubBrick(slot, h.x);
+  if ((P.foamFlags & kFoamSkip) != 0u) bits = bits & ~rcFoamSubBrick(slot, h.x);
   return bitBrickHalfCount(bits, h.y);
 }
 
@@ -107,13 +106,13 @@ FS_FUNC uint rcFoamHalfCountOfBits(uint slot, uvec2 h) { return bitBrickHalfCoun
 
 // Density (0..1) of the sphere cells in the 4^3 block holding brick-local `cell` (§3.6).
 FS_FUNC float rcLiquidDensity(uint slot, ivec3 cell) {
-  return float(rcLiquidHalfCount(slot, rcHalfBlock((cell + ivec3(int(P.brick.x))) >> 2))) / 64.0f;
+  return float(rcLiquidHalfCount(slot, rcHalfBlock((cell + ivec3(int(P.overlap))) >> 2))) / 64.0f;
 }
 
 // Foam density (0..1) at brick-local point `p`: trilinear between the centres of the 4^3 blocks
 // of the foam bit-brick, each block's density its set bits / 64 (§3.5, Fig. 7).
 FS_FUNC float rcFoamDensity(uint slot, vec3 p) {
-  vec3 u = (p + vec3(float(P.brick.x))) * 0.25f - vec3(0.5f);
+  vec3 u = (p + vec3(float(P.overlap))) * 0.25f - vec3(0.5f);
   vec3 f = floor(u);
   vec3 w = u - f;
   ivec3 b = ivec3(f);
@@ -128,42 +127,41 @@ FS_FUNC float rcFoamDensity(uint slot, vec3 p) {
 
 // The foam opacity `opacity` after the ray segment [a, b) (cells from the eye) through the
 // resident brick at `slot` (o: the eye in brick-local cells): samples at the fixed steps
-// t_i = (i + 0.5) * P.volume.x of the whole ray, each absorbing and emitting 1 - exp(-sigma
-// density step) of what is left (§3.5). Stops once the opacity reaches P.volume.z.
+// t_i = (i + 0.5) * P.foamStep of the whole ray, each absorbing and emitting 1 - exp(-sigma
+// density step) of what is left (§3.5). Stops once the opacity reaches P.foamOpacityStop.
 FS_FUNC float rcAccumulateFoam(float opacity, uint slot, vec3 o, vec3 dir, float a, float b) {
-  float step = P.volume.x;
+  float step = P.foamStep;
   float i = -floor(0.5f - a / step);  // the first i with t_i >= a
-  int n = int(P.brick.x);
-  for (uint k = 0u; k < kRaycastMaxSteps && opacity < P.volume.z; k++) {
+  int n = int(P.overlap);
+  for (uint k = 0u; k < kRaycastMaxSteps && opacity < P.foamOpacityStop; k++) {
     float t = (i + 0.5f) * step;
     if (t >= b) break;
     i += 1.0f;
     // Empty-space skipping: no foam within a sub-brick of the sample, no density.
     vec3 p = o + t * dir;
-    ivec3 cell = clamp(ivec3(floor(p)), ivec3(-n), ivec3(int(P.grid.w) + n - 1));
-    uint subBrick = bitBrickSubBrickIndex(cell, P.grid.w, P.brick.x);
+    ivec3 cell = clamp(ivec3(floor(p)), ivec3(-n), ivec3(int(P.brickSize) + n - 1));
+    uint subBrick = bitBrickSubBrickIndex(cell, P.brickSize, P.overlap);
     if (((rcFoamOccupancy(slot, subBrick >> 5u) >> (subBrick & 31u)) & 1u) == 0u) continue;
     float density = rcFoamDensity(slot, p);
-    if (density > 0.0f) opacity += (1.0f - opacity) * (1.0f - exp(-P.volume.y * density * step));
+    if (density > 0.0f) opacity += (1.0f - opacity) * (1.0f - exp(-P.foamExtinction * density * step));
   }
   return opacity;
 }
 
 // Whether `ray` has met foam opaque enough to end it (kFoamVolume).
-FS_FUNC bool rcFoamOpaque(RayHit ray) { return (P.foam.x & kFoamVolume) != 0u && ray.foam >= P.volume.z; }
+FS_FUNC bool rcFoamOpaque(RayHit ray) { return (P.foamFlags & kFoamVolume) != 0u && ray.foam >= P.foamOpacityStop; }
 
 FS_FUNC float rcCellAttribute(uint slot, ivec3 cell) {
-  if (P.pool.y == 0u) return 0.0f;
-  uint overlap = P.brick.x;
-  uint subBrick = bitBrickSubBrickIndex(cell, P.grid.w, overlap);
+  if (P.attributes == 0u) return 0.0f;
+  uint subBrick = bitBrickSubBrickIndex(cell, P.brickSize, P.overlap);
   uvec4 bits = rcSubBrick(slot, subBrick);
-  uint index = bitBrickAttributeOffset(rcAttributeBase(slot, subBrick), bits, bitBrickBitIndex(cell, overlap));
+  uint index = bitBrickAttributeOffset(rcAttributeBase(slot, subBrick), bits, bitBrickBitIndex(cell, P.overlap));
   return float(rcAttribute(index)) / 65535.0f;
 }
 
 // Whether the mip block of `level` around brick-local `cell` is clear (holds no sphere).
 FS_FUNC bool rcMipClear(uint slot, uint level, ivec3 cell) {
-  uvec3 s = uvec3(cell + ivec3(int(P.brick.x)));
+  uvec3 s = uvec3(cell + ivec3(int(P.overlap)));
   uvec3 block = uvec3(s.x >> (level + 1u), s.y >> (level + 1u), s.z >> (level + 2u));
   uvec4 dims = P.mipLevels[level - 1u];
   uint bit = block.x + dims.x * (block.y + dims.y * block.z);
@@ -177,12 +175,12 @@ FS_FUNC bool rcMipClear(uint slot, uint level, ivec3 cell) {
 // coarser one is too: walk up from level 1.
 FS_FUNC float rcClearBlockExit(uint slot, ivec3 cell, vec3 o, vec3 invDir) {
   uint clearLevel = 0u;
-  for (uint level = 1u; level <= P.pool.w; level++) {
+  for (uint level = 1u; level <= P.mipLevelCount; level++) {
     if (!rcMipClear(slot, level, cell)) break;
     clearLevel = level;
   }
   if (clearLevel == 0u) return -1.0f;
-  int overlap = int(P.brick.x);
+  int overlap = int(P.overlap);
   ivec3 size = ivec3(2 << clearLevel, 2 << clearLevel, 4 << clearLevel);
   ivec3 s = cell + ivec3(overlap);  // >= 0; sizes are powers of two
   ivec3 lo = (s & ~(size - ivec3(1))) - ivec3(overlap);
@@ -210,7 +208,7 @@ FS_FUNC NearestSphere rcNoSphere() {
 // the ray's origin: p is within a few cells of the centre, so b * b - c does not cancel
 // catastrophically far from the camera.
 FS_FUNC NearestSphere rcNearerSphere(NearestSphere nearest, ivec3 cell, vec3 centre, vec3 p, float t, vec3 dir) {
-  float radius = P.sphere.x;
+  float radius = P.radius;
   vec3 oc = p - centre;
   float b = dot(oc, dir);
   float c = dot(oc, oc) - radius * radius;
@@ -239,9 +237,9 @@ FS_FUNC void rcSphereHit(FS_INOUT(RayHit) ray, uint slot, NearestSphere nearest)
 // `result` a hit (status kRayHit) or leaves its status pending; with kFoamVolume it adds the foam
 // in front of the hit (or of tEnd) to result.foam and returns as soon as rcFoamOpaque.
 FS_FUNC void rcTraceBrick(FS_INOUT(RayHit) result, uint slot, uvec3 brick, vec3 eye, vec3 dir, float t, float tEnd) {
-  int B = int(P.grid.w);
-  int k = int(P.brick.y);
-  float jitter = P.sphere.y;
+  int B = int(P.brickSize);
+  int k = int(P.reach);
+  float jitter = P.maxJitter;
   vec3 brickOrigin = vec3(brick * uvec3(uint(B)));
   vec3 o = eye - brickOrigin;  // ray origin in brick-local cells
   vec3 invDir = rcSafeInverse(dir);
@@ -270,7 +268,7 @@ FS_FUNC void rcTraceBrick(FS_INOUT(RayHit) result, uint slot, uvec3 brick, vec3 
           vec3 centre = vec3(q) + vec3(0.5f);
           if (jitter > 0.0f) {
             uvec3 global = uvec3(ivec3(brick * uvec3(uint(B))) + q);
-            centre += cellJitter(global, P.image.z, jitter);
+            centre += cellJitter(global, P.timeStep, jitter);
           }
           nearest = rcNearerSphere(nearest, q, centre, p, t, dir);
         }
@@ -278,7 +276,7 @@ FS_FUNC void rcTraceBrick(FS_INOUT(RayHit) result, uint slot, uvec3 brick, vec3 
     }
     previous = cell;
     float cellExit = rcBoxSpan(o, invDir, vec3(cell), vec3(cell + ivec3(1))).y;
-    if ((P.foam.x & kFoamVolume) != 0u) {
+    if ((P.foamFlags & kFoamVolume) != 0u) {
       result.foam = rcAccumulateFoam(result.foam, slot, o, dir, t, min(cellExit, nearest.t));
       if (rcFoamOpaque(result)) return;
     }
@@ -293,7 +291,7 @@ FS_FUNC void rcTraceBrick(FS_INOUT(RayHit) result, uint slot, uvec3 brick, vec3 
 // Index of `brick` (brick-grid coordinates inside the grid) in the frame's brick table, or
 // kNotResident when the presence octree has no such brick.
 FS_FUNC uint rcBrickIndex(uvec3 brick) {
-  uint levels = P.brick.z;
+  uint levels = P.octreeLevels;
   uint node = 0u;
   uvec3 origin = uvec3(0u);
   for (uint level = 0u; level < levels; level++) {
@@ -319,19 +317,19 @@ struct ThicknessTrace {
 // Thickness of the liquid behind a hit at tHit (§3.6: "tracing each ray through the fluid body,
 // using our proposed density calculation, until maximum absorption is reached"): the density of
 // the sphere cells (rcLiquidDensity) summed at steps of kThicknessStep cells along the ray until
-// it reaches P.sphere.w cells, after kThicknessMaxCells cells, or at the grid's end. With
-// P.sphere.z = 1 (best effort) bricks that are not resident count as empty.
+// it reaches P.thicknessSaturationCells cells, after kThicknessMaxCells cells, or at the grid's
+// end. With P.thicknessBestEffort = 1u, bricks that are not resident count as empty.
 FS_FUNC ThicknessTrace rcThickness(vec3 eye, vec3 dir, float tHit) {
-  int B = int(P.grid.w);
-  int brickShift = findLSB(P.grid.w);  // B is a power of two
-  ivec3 gridCells = ivec3(int(P.grid.x), int(P.grid.y), int(P.grid.z)) * B;
-  bool bestEffort = P.sphere.z > 0.5f;
+  int B = int(P.brickSize);
+  int brickShift = findLSB(P.brickSize);  // B is a power of two
+  ivec3 gridCells = ivec3(P.bricksPerAxis) * B;
+  bool bestEffort = P.thicknessBestEffort != 0u;
   ivec3 current = ivec3(-1);
   uint slot = kNotResident;
   ThicknessTrace trace;
   trace.cells = 0.0f;
   trace.missingBrick = kNotResident;
-  for (uint i = 0u; i < kThicknessMaxCells / kThicknessStep && trace.cells < P.sphere.w; i++) {
+  for (uint i = 0u; i < kThicknessMaxCells / kThicknessStep && trace.cells < P.thicknessSaturationCells; i++) {
     vec3 p = eye + (tHit + (0.5f + float(i)) * float(kThicknessStep)) * dir;
     ivec3 cell = ivec3(floor(p));
     if (cell.x < 0 || cell.y < 0 || cell.z < 0 || cell.x >= gridCells.x || cell.y >= gridCells.y ||
@@ -359,21 +357,21 @@ FS_FUNC void rcTrace(uvec2 pixel, FS_INOUT(RayHit) result) {
   vec3 eye = vec3(P.eye.x, P.eye.y, P.eye.z);
   vec3 dir = rcCameraRay(pixel);
   vec3 invDir = rcSafeInverse(dir);
-  uint B = P.grid.w;
-  vec3 gridCells = vec3(uvec3(P.grid.x, P.grid.y, P.grid.z) * uvec3(B));
+  uint B = P.brickSize;
+  vec3 gridCells = vec3(uvec3(P.bricksPerAxis) * uvec3(B));
   vec2 domain = rcBoxSpan(eye, invDir, vec3(0.0f), gridCells);
   result.status = kRayMiss;
   result.brickIndex = kNotResident;
   result.depth = 0.0f;
   result.t = 0.0f;  // a miss carries no distance
-  if (P.pool.z == 0u || domain.x > domain.y || domain.y < 0.0f) return;
+  if (P.frameBricks == 0u || domain.x > domain.y || domain.y < 0.0f) return;
   float t = max(max(resume, domain.x), 0.0f);
-  uint levels = P.brick.z;
+  uint levels = P.octreeLevels;
   for (uint step = 0u; step < kRaycastMaxSteps; step++) {
     if (t > domain.y) return;
     vec3 p = eye + t * dir;
     // B is a power of two: multiplying by 1 / B is exact, and cheaper than dividing.
-    uvec3 brick = uvec3(clamp(ivec3(floor(p * (1.0f / float(B)))), ivec3(0), ivec3(P.grid.x, P.grid.y, P.grid.z) - ivec3(1)));
+    uvec3 brick = uvec3(clamp(ivec3(floor(p * (1.0f / float(B)))), ivec3(0), ivec3(P.bricksPerAxis) - ivec3(1)));
     // 1. Descend the presence octree to the brick, or to the empty octant holding the point.
     uint node = 0u;
     uvec3 origin = uvec3(0u);
@@ -419,7 +417,7 @@ FS_FUNC void rcTrace(uvec2 pixel, FS_INOUT(RayHit) result) {
     }
     if (result.status == kRayHit) {
       result.brickIndex = brickIndex;
-      result.depth = result.t * P.up.w * dot(dir, vec3(P.forward.x, P.forward.y, P.forward.z));
+      result.depth = result.t * P.cellSize * dot(dir, vec3(P.forward.x, P.forward.y, P.forward.z));
       return;
     }
     result.status = kRayMiss;
@@ -429,17 +427,18 @@ FS_FUNC void rcTrace(uvec2 pixel, FS_INOUT(RayHit) result) {
 
 // Fills in the thickness of a hit `ray` (status kRayHit) for `pixel`: the bricks behind the hit
 // must be resident; a missing one is requested and the thickness stays -1 (unknown), so the
-// next pass comes back to it. The hit itself is final. P.sphere.w = 0: thickness 0 at once.
+// next pass comes back to it. The hit itself is final. P.thicknessSaturationCells = 0: thickness
+// 0 at once.
 FS_FUNC void rcResolveThickness(uvec2 pixel, FS_INOUT(RayHit) ray) {
   ray.thickness = 0.0f;
-  if (P.sphere.w <= 0.0f) return;
+  if (P.thicknessSaturationCells <= 0.0f) return;
   vec3 eye = vec3(P.eye.x, P.eye.y, P.eye.z);
   ThicknessTrace trace = rcThickness(eye, rcCameraRay(pixel), ray.t);
   if (trace.missingBrick != kNotResident) {
     rcRequest(trace.missingBrick);
     ray.thickness = -1.0f;
   } else {
-    ray.thickness = trace.cells * P.up.w;
+    ray.thickness = trace.cells * P.cellSize;
   }
 }
 

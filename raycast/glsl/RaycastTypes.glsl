@@ -1,29 +1,47 @@
 // Structs the CPU fills and the ray-caster reads, shared by C++ (raycast/RaycastTypes.h, which
 // checks every offset) and GLSL; see core/GlslShared.h for the rules. RaycastParams is a std140
 // uniform block, RayHit a std430 array element: only 16-byte vectors and scalars in groups of
-// four, so both layouts equal the C++ one.
+// four, so both layouts equal the C++ one. Every field is named: no lane of a vector carries a
+// second meaning.
 //
 // Units. The ray-caster works in grid cells: cell (i,j,k) spans [i, i+1) x ... and brick b spans
 // cells [b*B, b*B + B). Grid and world axes are parallel (world = origin + cells * cellSize), so
 // directions and normals are the same in both.
 
 struct RaycastParams {
-  vec4 eye;      // xyz: eye in grid cells
-  vec4 forward;  // xyz: unit view direction; w: tan(vertical fov / 2)
-  vec4 right;    // xyz: unit right vector; w: width / height
-  vec4 up;       // xyz: unit up vector; w: cell size in world units (depth output)
-  uvec4 image;   // x, y: width, height in pixels; z: time step (jitter seed); w: unused
-  uvec4 grid;    // xyz: bricks per axis; w: cells per brick edge B
-  uvec4 brick;   // x: overlap n; y: neighbourhood k; z: octree levels; w: sub-bricks per slot
-  uvec4 pool;    // x: mip words per slot; y: 1 with attributes; z: bricks in the frame; w: mip levels
-  vec4 sphere;   // x: radius in cells; y: max jitter in cells; z: 1 = thickness best effort
-                 // (bricks behind a hit that are not resident count as empty), 0 = request them;
-                 // w: liquid thickness in cells at which absorption saturates: the trace behind a
-                 // hit stops there (§3.6); 0 = no thickness (a hit is final at once)
-  uvec4 foam;    // x: kFoamSkip | kFoamVolume flags (§3.5; 0: every set cell is a sphere); yzw: unused
-  vec4 volume;   // volumetric foam (§3.5): x: march step in cells; y: extinction per cell at foam
-                 // density 1; z: opacity at which the march ends the ray; w: unused
-  uvec4 mipLevels[8];  // level k (1..pool.w) at k - 1: xyz blocks per axis, w word offset
+  vec4 eye;            // xyz: eye in grid cells; w: unused
+  vec4 forward;        // xyz: unit view direction; w: unused
+  vec4 right;          // xyz: unit right vector; w: unused
+  vec4 up;             // xyz: unit up vector; w: unused
+  uvec4 bricksPerAxis; // xyz: bricks of the grid per axis; w: unused
+  float tanHalfFovY;   // tan(vertical fov / 2)
+  float aspect;        // width / height
+  float cellSize;      // world units (the depth output is in world units)
+  float unused0;
+  uint width;          // pixels
+  uint height;         // pixels
+  uint timeStep;       // the jitter's seed (§3.2.2)
+  uint brickSize;      // cells per brick edge B, a power of two
+  uint overlap;        // n: cells each stored bit-brick reaches beyond its brick on every side
+  uint reach;          // k: a sphere reaches cells at most k away from its own
+  uint octreeLevels;   // levels of the frame's presence octree (§3.2.1)
+  uint subBricksPerSlot;
+  uint mipWordsPerSlot;
+  uint attributes;     // 1: the pool holds attributes; 0: hits report attribute 0
+  uint frameBricks;    // bricks in the frame; 0: an empty frame, every ray misses
+  uint mipLevelCount;  // levels of mipLevels in use (0 to kMaxMipLevels)
+  float radius;        // sphere radius in cells
+  float maxJitter;     // largest jitter offset of a sphere centre, cells (§3.2.2)
+  uint thicknessBestEffort;        // 1: bricks behind a hit that are not resident count as
+                                   // empty; 0: request them
+  float thicknessSaturationCells;  // liquid thickness in cells at which absorption saturates: the
+                                   // trace behind a hit stops there (§3.6); 0 = no thickness (a hit
+                                   // is final at once)
+  uint foamFlags;      // kFoamSkip | kFoamVolume (§3.5); 0: every set cell is a sphere
+  float foamStep;      // volumetric foam (§3.5): the march's step in cells
+  float foamExtinction;   // extinction per cell at foam density 1
+  float foamOpacityStop;  // opacity at which the foam's march ends the ray
+  uvec4 mipLevels[8];  // level k (1..mipLevelCount) at k - 1: xyz blocks per axis, w word offset
 };
 
 // One pixel's ray. All zeros is a fresh ray: pending from t = 0 (so a device clears the whole
@@ -42,8 +60,9 @@ struct RayHit {
                    // pass), kNotResident on a miss
   float thickness; // liquid along the ray behind the hit, world units (§3.6): the density of the
                    // surface cells (set bits of the 4^3 half sub-brick at every kThicknessStep
-                   // cells), summed until it reaches sphere.w cells or after kThicknessMaxCells
-                   // cells, times the cell size; -1 while the bricks it needs are not resident
+                   // cells), summed until it reaches thicknessSaturationCells or after
+                   // kThicknessMaxCells cells, times the cell size; -1 while the bricks it needs
+                   // are not resident
   float foam;      // opacity of the volumetric foam in front of the hit (or along a miss), 0..1
                    // (§3.5); it accumulates while the ray is pending; 0 without kFoamVolume
   float unused1;

@@ -31,8 +31,8 @@ struct CpuScreenKernel {
     return in->images[image][index];
   }
   vec4 ssLoad(uint image, ivec2 p) const {
-    const ivec2 q = clamp(p, ivec2(0), ivec2(int(F.size.x) - 1, int(F.size.y) - 1));
-    return ssLoadIndex(image, uint(q.y) * F.size.x + uint(q.x));
+    const ivec2 q = clamp(p, ivec2(0), ivec2(int(F.width) - 1, int(F.height) - 1));
+    return ssLoadIndex(image, uint(q.y) * F.width + uint(q.x));
   }
 #include "smoothing/glsl/ScreenMath.glsl"
 };
@@ -52,7 +52,7 @@ void cpuScreenPass(const CpuPassInputs& inputs, const void* params, glm::vec4* o
   prototype.F = inputs.frame;
   prototype.in = &inputs;
   if constexpr (requires { prototype.S; }) prototype.S = *static_cast<const decltype(prototype.S)*>(params);
-  const std::uint32_t width = inputs.frame.size.x, height = inputs.frame.size.y;
+  const std::uint32_t width = inputs.frame.width, height = inputs.frame.height;
   tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, height), [&](const tbb::blocked_range<std::uint32_t>& rows) {
     Kernel kernel = prototype;
     for (std::uint32_t y = rows.begin(); y != rows.end(); ++y) {

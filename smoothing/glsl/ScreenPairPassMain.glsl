@@ -5,8 +5,8 @@ layout(std430, binding = 7) writeonly buffer SecondOutput { vec4 secondOutputPix
 
 void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
-  if (pixel.x >= F.size.x || pixel.y >= F.size.y) return;
-  uint i = pixel.y * F.size.x + pixel.x;
+  if (pixel.x >= F.width || pixel.y >= F.height) return;
+  uint i = pixel.y * F.width + pixel.x;
   ScreenPair values = FS_KERNEL(ivec2(pixel));
   outputPixels[i] = values.first;
   secondOutputPixels[i] = values.second;

@@ -23,7 +23,7 @@ vec4 ssLoadIndex(uint image, uint index) {
 
 // Pixel `p` of a frame-sized input image, clamped to the image.
 vec4 ssLoad(uint image, ivec2 p) {
-  ivec2 q = clamp(p, ivec2(0), ivec2(int(F.size.x) - 1, int(F.size.y) - 1));
-  return ssLoadIndex(image, uint(q.y) * F.size.x + uint(q.x));
+  ivec2 q = clamp(p, ivec2(0), ivec2(int(F.width) - 1, int(F.height) - 1));
+  return ssLoadIndex(image, uint(q.y) * F.width + uint(q.x));
 }
 #include "ScreenMath.glsl"

@@ -7,11 +7,14 @@
 // camera depth in world units (distance along the view direction), as the ray-caster writes it.
 
 struct ScreenFrame {
-  uvec4 size;     // x, y: width, height in pixels; z, w: unused
-  vec4 forward;   // xyz: unit view direction (world); w: tan(vertical fov / 2)
-  vec4 right;     // xyz: unit right vector (world); w: width / height
-  vec4 up;        // xyz: unit up vector of the image (world); w: unused
-  vec4 worldUp;   // xyz: unit up axis of the scene (world), for the environment; w: unused
+  vec4 forward;          // xyz: unit view direction (world); w: unused
+  vec4 right;            // xyz: unit right vector (world); w: unused
+  vec4 up;               // xyz: unit up vector of the image (world); w: unused
+  vec4 worldUp;          // xyz: unit up axis of the scene (world), for the environment; w: unused
+  uint width;            // pixels
+  uint height;           // pixels
+  float tanHalfFovY;     // tan(vertical fov / 2)
+  float aspect;          // width / height
   float focalPixels;     // image height / (2 tan(fov / 2)): pixels per world unit at depth 1
   float particleRadius;  // sphere radius in world units
   float cellSize;        // world units

@@ -24,7 +24,7 @@ TEST(FoamNeighbourCount, EqualsTheReferenceClassification) {
     for (float threshold : {0.0f, 0.2f, 0.5f}) {
       for (float density : {0.03f, 0.3f, 0.85f}) {
         for (bool uploaded : {false, true}) {
-          for (float classify : {1.0f, 0.0f}) {
+          for (std::uint32_t classify : {1u, 0u}) {
             SCOPED_TRACE(::testing::Message() << "radius " << radius << " threshold " << threshold << " density "
                                               << density << " uploaded foam " << uploaded << " classify " << classify);
             CpuRaycaster::Pool pool;
@@ -44,8 +44,13 @@ TEST(FoamNeighbourCount, EqualsTheReferenceClassification) {
               pool.foamBits[s] = foam & bits;
             }
             FoamClassifyParams params{};
-            params.brick = glm::uvec4(brickSize, overlap, subBricks, subBricks);
-            params.sphere = glm::vec4(radius, threshold, classify, 0.0f);
+            params.brickSize = brickSize;
+            params.overlap = overlap;
+            params.subBricksPerSlot = subBricks;
+            params.batchSubBricks = subBricks;
+            params.radius = radius;
+            params.threshold = threshold;
+            params.classify = classify;
             glsl::FoamKernel reference{params, &pool};
             std::vector<glm::uvec4> fast(pool.foamBits.begin(), pool.foamBits.end());
             classifyBrickFoam(pool.subBricks.data(), fast.data(), params, scratch);

@@ -54,8 +54,13 @@ inline PoolLayout foamTestLayout(const FoamBrickShape& shape, std::uint32_t slot
 inline FoamClassifyParams foamTestParams(const FoamBrickShape& shape, std::size_t slots, float threshold,
                                          std::uint32_t subBricksPerSlot) {
   FoamClassifyParams p{};
-  p.brick = glm::uvec4(shape.brickSize, shape.overlap, subBricksPerSlot, std::uint32_t(slots) * subBricksPerSlot);
-  p.sphere = glm::vec4(shape.radius, threshold, 1.0f, 0.0f);
+  p.brickSize = shape.brickSize;
+  p.overlap = shape.overlap;
+  p.subBricksPerSlot = subBricksPerSlot;
+  p.batchSubBricks = std::uint32_t(slots) * subBricksPerSlot;
+  p.radius = shape.radius;
+  p.threshold = threshold;
+  p.classify = 1u;
   return p;
 }
 

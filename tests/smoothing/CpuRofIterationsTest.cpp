@@ -56,7 +56,7 @@ TEST(CpuRofIterations, EqualThePassesRunOneByOne) {
   for (const testing::DepthScene& scene : scenes) {
     for (int iterations : {1, 2, 17, 75}) {
       for (float strength : {0.5f, 3.0f}) {
-        SCOPED_TRACE(::testing::Message() << scene.frame.size.x << "x" << scene.frame.size.y << ", " << iterations
+        SCOPED_TRACE(::testing::Message() << scene.frame.width << "x" << scene.frame.height << ", " << iterations
                                           << " iterations, strength " << strength);
         const SmoothingOptions options{.name = "rof", .iterations = iterations, .strength = strength};
         CpuScreenDevice cpu;
@@ -85,7 +85,7 @@ TEST(CpuRofIterations, OneFilterKeepsNothingFromItsLastFrame) {
   CpuScreenDevice cpu;
   const auto filter = createSurfaceFilter(options);
   for (const testing::DepthScene& scene : scenes) {
-    SCOPED_TRACE(::testing::Message() << scene.frame.size.x << "x" << scene.frame.size.y);
+    SCOPED_TRACE(::testing::Message() << scene.frame.width << "x" << scene.frame.height);
     cpu.setFrame(scene.frame);
     const ScreenImage depth = cpu.createFrameImage(), output = cpu.createFrameImage();
     cpu.upload(depth, scene.depth);

@@ -25,7 +25,7 @@ TEST(RofFilter, PlanarDepthIsAFixedPointAwayFromTheBoundary) {
 /// The discrete ROF energy of u for data v with the per-pixel lambda^(0) of eq. 7, on the
 /// foreground (forward differences, Neumann).
 double rofEnergy(const std::vector<glm::vec4>& u, const DepthScene& s, float strength) {
-  const std::uint32_t w = s.frame.size.x, h = s.frame.size.y;
+  const std::uint32_t w = s.frame.width, h = s.frame.height;
   const float r = s.frame.particleRadius;
   const double lambda0 = strength * s.frame.focalPixels * r * r;
   double e = 0;

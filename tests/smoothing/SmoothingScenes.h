@@ -27,11 +27,14 @@ inline ScreenFrame testFrame(std::uint32_t width, std::uint32_t height, float ra
                              float fovDegrees = 40.0f) {
   ScreenFrame f{};
   const float t = std::tan(fovDegrees * 3.14159265f / 360.0f);
-  f.size = glm::uvec4(width, height, 0, 0);
-  f.forward = glm::vec4(0, 0, -1, t);
-  f.right = glm::vec4(1, 0, 0, float(width) / float(height));
+  f.forward = glm::vec4(0, 0, -1, 0);
+  f.right = glm::vec4(1, 0, 0, 0);
   f.up = glm::vec4(0, 1, 0, 0);
   f.worldUp = glm::vec4(0, 1, 0, 0);
+  f.width = width;
+  f.height = height;
+  f.tanHalfFovY = t;
+  f.aspect = float(width) / float(height);
   f.focalPixels = float(height) / (2.0f * t);
   f.particleRadius = radius;
   f.cellSize = radius;
@@ -40,8 +43,8 @@ inline ScreenFrame testFrame(std::uint32_t width, std::uint32_t height, float ra
 
 /// The unit ray through the centre of pixel (x, y) (mirrors ssPixelRay).
 inline glm::vec3 pixelRay(const ScreenFrame& f, int x, int y) {
-  const float sx = ((x + 0.5f) / f.size.x * 2 - 1) * f.forward.w * f.right.w;
-  const float sy = (1 - (y + 0.5f) / f.size.y * 2) * f.forward.w;
+  const float sx = ((x + 0.5f) / f.width * 2 - 1) * f.tanHalfFovY * f.aspect;
+  const float sy = (1 - (y + 0.5f) / f.height * 2) * f.tanHalfFovY;
   return glm::normalize(glm::vec3(0, 0, -1) + sx * glm::vec3(1, 0, 0) + sy * glm::vec3(0, 1, 0));
 }
 
@@ -199,7 +202,7 @@ inline std::vector<glm::vec4> smoothOnCpu(const DepthScene& scene, const Smoothi
 /// edge for which counts(i) holds.
 template <class Value, class Counts>
 double meanAbsLaplacian(const ScreenFrame& frame, Value value, Counts counts) {
-  const std::uint32_t w = frame.size.x, h = frame.size.y;
+  const std::uint32_t w = frame.width, h = frame.height;
   double sum = 0;
   int count = 0;
   for (std::uint32_t y = 1; y + 1 < h; ++y)
@@ -215,7 +218,7 @@ double meanAbsLaplacian(const ScreenFrame& frame, Value value, Counts counts) {
 /// Mean |5-point Laplacian| of the depth `d` over the pixels whose 4-neighbourhood is foreground
 /// in `d` (the surface's own curvature included).
 inline double depthRoughness(const std::vector<glm::vec4>& d, const DepthScene& s) {
-  const std::size_t w = s.frame.size.x;
+  const std::size_t w = s.frame.width;
   return meanAbsLaplacian(
       s.frame, [&](std::size_t j) { return double(d[j].x); },
       [&](std::size_t i) {
@@ -227,7 +230,7 @@ inline double depthRoughness(const std::vector<glm::vec4>& d, const DepthScene& 
 /// surface's own curvature) over the pixels of a continuous surface: whose four neighbours are
 /// foreground with exact depths within 0.05 (2.5 particle radii) of theirs.
 inline double noiseRoughness(const std::vector<glm::vec4>& d, const DepthScene& s) {
-  const std::size_t w = s.frame.size.x;
+  const std::size_t w = s.frame.width;
   return meanAbsLaplacian(
       s.frame, [&](std::size_t j) { return double(d[j].x) - s.exactDepth[j]; },
       [&](std::size_t i) {
@@ -256,7 +259,7 @@ inline double rmsError(const std::vector<glm::vec4>& d, const DepthScene& s, flo
 
 /// The largest |out - input depth| over the pixels at least `margin` pixels inside the frame.
 inline double worstChange(const std::vector<glm::vec4>& out, const DepthScene& s, int margin = 0) {
-  const int w = int(s.frame.size.x), h = int(s.frame.size.y);
+  const int w = int(s.frame.width), h = int(s.frame.height);
   double worst = 0;
   for (int y = margin; y < h - margin; ++y)
     for (int x = margin; x < w - margin; ++x) {

@@ -33,9 +33,9 @@ std::vector<glm::vec4> normalsOnCpu(const DepthScene& scene, const std::vector<g
 AngleError normalError(const DepthScene& scene, const std::vector<glm::vec4>& depth) {
   const auto normals = normalsOnCpu(scene, depth);
   std::vector<double> angles;
-  for (int y = 0; y < int(scene.frame.size.y); ++y)
-    for (int x = 0; x < int(scene.frame.size.x); ++x) {
-      const std::size_t i = std::size_t(y) * scene.frame.size.x + x;
+  for (int y = 0; y < int(scene.frame.height); ++y)
+    for (int x = 0; x < int(scene.frame.width); ++x) {
+      const std::size_t i = std::size_t(y) * scene.frame.width + x;
       const glm::vec3 exact = scene.normals[i];
       if (exact.z < 0.99f && glm::dot(exact, -testing::pixelRay(scene.frame, x, y)) < 0.34f) continue;
       if (scene.depth[i].y < 0.5f || exact == glm::vec3(0, 0, 1)) continue;  // background and plane
