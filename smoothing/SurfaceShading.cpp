@@ -12,10 +12,16 @@ namespace flipscope {
 namespace glsl {
 #include "smoothing/glsl/ColorMap.glsl"
 #include "smoothing/glsl/ShadingTypes.glsl"
-static_assert(sizeof(ShadingParams) == 8 * 16 && offsetof(ShadingParams, foamColour) == 64 &&
-              offsetof(ShadingParams, mode) == 80 && offsetof(ShadingParams, colorMap) == 92 &&
-              offsetof(ShadingParams, fresnelF0) == 96 && offsetof(ShadingParams, shininess) == 108 &&
-              offsetof(ShadingParams, colorBy) == 112 && offsetof(ShadingParams, attributeOffset) == 124);
+static_assert(sizeof(ShadingParams) == 8 * 16);
+static_assert(offsetof(ShadingParams, lightDirection) == 0 && offsetof(ShadingParams, absorption) == 16 &&
+              offsetof(ShadingParams, liquidColour) == 32 && offsetof(ShadingParams, albedo) == 48 &&
+              offsetof(ShadingParams, foamColour) == 64);
+static_assert(offsetof(ShadingParams, mode) == 80 && offsetof(ShadingParams, environmentWidth) == 84 &&
+              offsetof(ShadingParams, environmentHeight) == 88 && offsetof(ShadingParams, colorMap) == 92);
+static_assert(offsetof(ShadingParams, fresnelF0) == 96 && offsetof(ShadingParams, refraction) == 100 &&
+              offsetof(ShadingParams, specular) == 104 && offsetof(ShadingParams, shininess) == 108);
+static_assert(offsetof(ShadingParams, colorBy) == 112 && offsetof(ShadingParams, compositeFoam) == 116 &&
+              offsetof(ShadingParams, attributeScale) == 120 && offsetof(ShadingParams, attributeOffset) == 124);
 static_assert(kColorMapCount == 4u && kColorMapBlues == std::uint32_t(ColorMap::Blues));
 
 struct ShadingKernel : CpuScreenKernel {
@@ -78,11 +84,12 @@ void SurfaceShading::shade(ScreenDevice& device, ScreenImage gbuffer, ScreenImag
   const glm::vec3 light = glm::normalize(mOptions.lightFromCamera.x * right + mOptions.lightFromCamera.y * up -
                                          mOptions.lightFromCamera.z * forward);
   glsl::ShadingParams p{};
-  p.lightDirection = glm::vec4(light, 1.0f);
+  p.lightDirection = glm::vec4(light, 0.0f);
   p.absorption = glm::vec4(mOptions.absorption, 0);
   p.liquidColour = glm::vec4(mOptions.liquidColour, 0);
   p.albedo = glm::vec4(mOptions.albedo, 0);
-  p.foamColour = glm::vec4(mOptions.foamColour, mOptions.foam && mOptions.mode != ShadingMode::Normals ? 1.0f : 0.0f);
+  p.foamColour = glm::vec4(mOptions.foamColour, 0.0f);
+  p.compositeFoam = mOptions.foam && mOptions.mode != ShadingMode::Normals ? 1u : 0u;
   p.colorBy = mOptions.colorByAttribute ? 1u : 0u;
   p.colorMap = std::uint32_t(mOptions.colorMap);
   // t = (value - A) / (B - A), value = frameMin + w (frameMax - frameMin).

@@ -106,7 +106,7 @@ FS_FUNC vec3 shadeUnderFoam(ivec2 p) {
       float fresnel = S.fresnelF0 + (1.0f - S.fresnelF0) * pow(1.0f - cosine, 5.0f);
       vec3 reflected = shEnvironment(reflect(ray, n));
       vec3 halfway = normalize(sun + view);
-      float highlight = pow(max(dot(n, halfway), 0.0f), S.shininess) * S.specular * S.lightDirection.w;
+      float highlight = pow(max(dot(n, halfway), 0.0f), S.shininess) * S.specular;
       colour = mix(body, reflected, fresnel) + vec3(highlight);
     }
   }
@@ -116,7 +116,7 @@ FS_FUNC vec3 shadeUnderFoam(ivec2 p) {
 // shadeSurface -> linear RGB, alpha 1 (the environment behind the background).
 FS_FUNC vec4 shadeSurface(ivec2 p) {
   vec3 colour = shadeUnderFoam(p);
-  if (S.foamColour.w > 0.5f) {
+  if (S.compositeFoam != 0u) {
     float foam = ssLoad(2u, p).w;
     colour = vec3(S.foamColour.x, S.foamColour.y, S.foamColour.z) * foam + colour * (1.0f - foam);
   }
