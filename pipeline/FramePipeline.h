@@ -23,10 +23,10 @@
 
 #include <glm/vec3.hpp>
 
+#include "pipeline/ImageWriter.h"
 #include "raycast/Camera.h"
 #include "raycast/FrameRenderer.h"
 #include "raycast/GpuRaycaster.h"
-#include "raycast/ImageWriter.h"
 #include "smoothing/ScreenDevice.h"
 #include "smoothing/SurfaceFilter.h"
 #include "smoothing/SurfaceShading.h"

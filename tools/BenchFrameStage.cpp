@@ -10,8 +10,8 @@
 #include "core/Error.h"
 #include "core/ProcessMemory.h"
 #include "pipeline/FramePipeline.h"
+#include "pipeline/ImageWriter.h"
 #include "pipeline/RenderRequest.h"
-#include "raycast/ImageWriter.h"
 #include "tools/ChildProcess.h"
 #include "tools/CliValues.h"
 

@@ -5,7 +5,7 @@
 #include "core/Error.h"
 #include "core/ProcessMemory.h"
 #include "core/Progress.h"
-#include "raycast/ImageWriter.h"
+#include "pipeline/ImageWriter.h"
 
 namespace flipscope::tools {
 

@@ -9,8 +9,8 @@
 #include "ProgressiveScenes.h"
 #include "core/Elapsed.h"
 #include "core/Error.h"
+#include "pipeline/ImageWriter.h"
 #include "raycast/CpuRaycaster.h"
-#include "raycast/ImageWriter.h"
 
 namespace flipscope {
 namespace {

@@ -13,7 +13,7 @@
 #include <glm/geometric.hpp>
 
 #include "TestSupport.h"
-#include "raycast/ImageWriter.h"
+#include "pipeline/ImageWriter.h"
 
 namespace {
 

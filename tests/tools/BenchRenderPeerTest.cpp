@@ -12,7 +12,7 @@
 #include <png.h>
 
 #include "TestSupport.h"
-#include "raycast/ImageWriter.h"
+#include "pipeline/ImageWriter.h"
 
 namespace {
 

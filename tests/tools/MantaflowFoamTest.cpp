@@ -10,7 +10,7 @@
 #include <string>
 
 #include "TestSupport.h"
-#include "raycast/ImageWriter.h"
+#include "pipeline/ImageWriter.h"
 
 namespace {
 

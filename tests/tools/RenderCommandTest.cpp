@@ -11,7 +11,7 @@
 #include <glm/geometric.hpp>
 #include "TestSupport.h"
 
-#include "raycast/ImageWriter.h"
+#include "pipeline/ImageWriter.h"
 
 namespace {
 

@@ -15,9 +15,9 @@
 
 #include "TestSupport.h"
 #include "XvfbDisplay.h"
+#include "pipeline/ImageWriter.h"
 #include "preprocess/store/BrickStore.h"
 #include "raycast/Camera.h"
-#include "raycast/ImageWriter.h"
 #include "viewer/ViewNavigation.h"
 
 namespace flipscope {

@@ -17,7 +17,7 @@
 
 #include "TestSupport.h"
 #include "core/Error.h"
-#include "raycast/ImageWriter.h"
+#include "pipeline/ImageWriter.h"
 
 namespace {
 

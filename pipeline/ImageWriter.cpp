@@ -1,4 +1,4 @@
-#include "raycast/ImageWriter.h"
+#include "pipeline/ImageWriter.h"
 
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
@@ -51,9 +51,9 @@ void checkImage(const RenderImage& image) {
 
 /// Every channel writeExr writes besides an attribute's.
 bool isImageChannel(const std::string& name) {
-  for (const char* channel : {"R", "G", "B", "A", "Z", kUnsmoothedDepthChannel, kThicknessChannel, kNormalChannels[0],
-                              kNormalChannels[1], kNormalChannels[2], kFoamChannels[0], kFoamChannels[1],
-                              kFoamChannels[2], kFoamChannels[3]})
+  for (const char* channel :
+       {"R", "G", "B", "A", "Z", kUnsmoothedDepthChannel, kThicknessChannel, kNormalChannels[0], kNormalChannels[1],
+        kNormalChannels[2], kFoamChannels[0], kFoamChannels[1], kFoamChannels[2], kFoamChannels[3]})
     if (name == channel) return true;
   return false;
 }
@@ -137,7 +137,7 @@ void writeExr(const std::filesystem::path& path, const RenderImage& image) {
   header.compression() = Imf::ZIP_COMPRESSION;
   Imf::FrameBuffer frame;
   // Four HALF channels from a vec4 image, converted into `storage` (kept alive until written).
-  auto insertHalf4 = [&](const char* const (&names)[4], const std::vector<glm::vec4>& values,
+  auto insertHalf4 = [&](const char* const(&names)[4], const std::vector<glm::vec4>& values,
                          std::vector<Imath::half>& storage) {
     if (values.empty()) return;
     storage.resize(4 * n);
@@ -145,8 +145,8 @@ void writeExr(const std::filesystem::path& path, const RenderImage& image) {
       for (int c = 0; c < 4; ++c) storage[4 * i + c] = Imath::half(values[i][c]);
     for (int c = 0; c < 4; ++c) {
       header.channels().insert(names[c], Imf::Channel(Imf::HALF));
-      frame.insert(names[c], Imf::Slice(Imf::HALF, reinterpret_cast<char*>(storage.data() + c),
-                                        4 * sizeof(Imath::half), 4 * sizeof(Imath::half) * width));
+      frame.insert(names[c], Imf::Slice(Imf::HALF, reinterpret_cast<char*>(storage.data() + c), 4 * sizeof(Imath::half),
+                                        4 * sizeof(Imath::half) * width));
     }
   };
   constexpr const char* kRgba[4] = {"R", "G", "B", "A"};
@@ -156,8 +156,8 @@ void writeExr(const std::filesystem::path& path, const RenderImage& image) {
   auto insertFloat = [&](const char* name, const std::vector<float>& values) {
     if (values.empty()) return;
     header.channels().insert(name, Imf::Channel(Imf::FLOAT));
-    frame.insert(name, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(values.data())),
-                                  sizeof(float), sizeof(float) * width));
+    frame.insert(name, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(values.data())), sizeof(float),
+                                  sizeof(float) * width));
   };
   insertFloat("Z", image.depth);
   insertFloat(kUnsmoothedDepthChannel, image.unsmoothedDepth);

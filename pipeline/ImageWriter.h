@@ -30,9 +30,9 @@ namespace flipscope {
 /// A rendered image, row 0 at the top, pixel (x, y) at index y * width + x.
 struct RenderImage {
   std::uint32_t width = 0, height = 0;
-  std::vector<glm::vec4> rgba;    ///< linear RGB, premultiplied alpha; width * height
-  std::vector<float> depth;       ///< camera depth, world units, +inf where alpha is 0; empty or width * height
-  std::vector<glm::vec3> normal;  ///< world-space unit normal, 0 where nothing was hit; empty or width * height
+  std::vector<glm::vec4> rgba;         ///< linear RGB, premultiplied alpha; width * height
+  std::vector<float> depth;            ///< camera depth, world units, +inf where alpha is 0; empty or width * height
+  std::vector<glm::vec3> normal;       ///< world-space unit normal, 0 where nothing was hit; empty or width * height
   std::vector<float> unsmoothedDepth;  ///< like depth, before smoothing; empty or width * height
   std::vector<float> thickness;        ///< world units, 0 where nothing was hit; empty or width * height
   /// The volumetric foam (§3.5) composited into rgba: its colour premultiplied by its opacity,
