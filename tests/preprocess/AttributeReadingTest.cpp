@@ -166,6 +166,37 @@ TEST(PlyAttributes, ColumnsHoldTheValuesWrittenInEveryEncoding) {
   }
 }
 
+// Binary records are read a megabyte at a time (PlyParticles.cpp, kBinarySliceBytes): a chunk of
+// 60000 records of 43 bytes spans three slices, the last one short. Every value lands at its own
+// particle, and a file cut inside the third slice says where it ends.
+TEST(PlyAttributes, AChunkOfSeveralReadSlicesKeepsEveryRecordInPlace) {
+  TempDir dir("ply-slices");
+  const auto rows = plyRows(60000);
+  const std::string bytes = plyFile("binary_little_endian", kPlyProperties, rows);
+  const auto path = dir.path() / "slices.ply";
+  writeBytes(path, bytes);
+  ReadOptions options;
+  options.velocity = true;
+  options.attributes = {"density", "age"};
+  auto source = openParticleFile(path, options);
+  ParticleChunk chunk;
+  ASSERT_TRUE(source->read(chunk, rows.size()));
+  ASSERT_EQ(chunk.size(), rows.size());
+  ASSERT_EQ(chunk.velocities.size(), rows.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    ASSERT_EQ(chunk.positions[i], glm::vec3(float(rows[i][0]), float(rows[i][1]), float(rows[i][2]))) << i;
+    ASSERT_EQ(chunk.velocities[i], glm::vec3(float(rows[i][3]), float(rows[i][4]), float(rows[i][5]))) << i;
+    ASSERT_EQ(chunk.attributes[0].values[i], float(rows[i][9])) << i;
+    ASSERT_EQ(chunk.attributes[1].values[i], float(rows[i][10])) << i;
+  }
+  EXPECT_FALSE(source->read(chunk, rows.size()));
+  const std::size_t header = bytes.size() - rows.size() * 43;
+  const std::size_t whole = 55000;  // in the third slice (records 48770 on)
+  writeBytes(path, bytes.substr(0, header + whole * 43 + 20));
+  expectFileError([&] { openParticleFile(path, options)->read(chunk, rows.size()); },
+                  {"slices.ply", "file ends at particle " + std::to_string(whole) + " of 60000"});
+}
+
 TEST(PlyAttributes, AMissingAttributeNamesTheFileAndWhatItHolds) {
   TempDir dir("ply-missing");
   const auto path = dir.path() / "few.ply";
