@@ -331,7 +331,7 @@ class PlyReader final : public ParticleSource {
     positions.resize(count);
     // A megabyte of records at a time, into each thread's buffer (kept: no fresh pages a range).
     const std::size_t stride = mHeader.vertexBytes;
-    const std::size_t slice = std::max<std::size_t>(1, kBinarySliceBytes / stride);
+    const std::size_t slice = recordsPerSlice();
     thread_local std::vector<std::byte> records;
     for (std::size_t done = 0; done < count; done += slice) {
       const std::size_t n = std::min(slice, count - done);
@@ -353,11 +353,14 @@ class PlyReader final : public ParticleSource {
                                        std::to_string(mHeader.vertexBytes) + " bytes a vertex)");
   }
 
+  /// Binary records in one read of kBinarySliceBytes (at least one).
+  std::size_t recordsPerSlice() const { return std::max<std::size_t>(1, kBinarySliceBytes / mHeader.vertexBytes); }
+
   /// A megabyte of records at a time (kBinarySliceBytes): the reader holds that, not a chunk's
   /// records (24 MB for a million particles of six floats), and the split reads them from the cache.
   void readBinary(ParticleChunk& chunk, std::uint64_t n) {
     const std::size_t stride = mHeader.vertexBytes;
-    const std::size_t slice = std::max<std::size_t>(1, kBinarySliceBytes / stride);
+    const std::size_t slice = recordsPerSlice();
     for (std::uint64_t done = 0; done < n; done += slice) {
       const std::size_t count = std::size_t(std::min<std::uint64_t>(slice, n - done));
       mBuffer.resize(count * stride);
