@@ -1056,6 +1056,11 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
         throw InputError(storeDir.string() + ": the store's cells are " + formatExact(header.cellSize) +
                          " world units, not " + formatExact(*options.cellSize) +
                          " (--cell-size); convert into a new store to change them");
+      if (options.particleSpacing && *options.particleSpacing != header.particleSpacing)
+        throw InputError(storeDir.string() + ": the store's particle spacing is " +
+                         formatExact(header.particleSpacing) + " world units, not " +
+                         formatExact(*options.particleSpacing) +
+                         " (--particle-spacing); convert into a new store to change it");
       report.cellSizeOrigin = "kept from the existing store";
       report.spacingOrigin = "the existing store";
       report.upAxisOrigin = header.version >= 6 ? "the existing store" : "a store older than version 6 records none";
@@ -1081,7 +1086,7 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
     std::vector<std::optional<Box>> measuredBounds;  // of the frames the spacing estimate read whole
     if (options.particleSpacing) {
       spacing.spacing = *options.particleSpacing;
-      spacing.origin = spacing.spacing > 0 ? "given" : "not measured";
+      spacing.origin = spacing.spacing > 0 ? "--particle-spacing" : "not measured (--particle-spacing 0)";
       if (!(std::isfinite(spacing.spacing) && spacing.spacing >= 0))
         throw InputError("particle spacing must be a positive number or 0");
     } else {

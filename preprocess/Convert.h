@@ -76,7 +76,9 @@ struct ConvertOptions {
   /// per particle spacing, makeStoreHeader() uses kDefaultResolution.
   std::optional<std::uint32_t> resolution;
   /// World units; default: measured on the first frame (estimateParticleSpacing: free for
-  /// OpenVDB points, one or two extra reads of the frame for other sources).
+  /// OpenVDB points, one or two extra reads of the frame for other sources). Given (0: unknown,
+  /// not measured), convert reads no frame for it, and with `domain` given too reads each
+  /// frame once. An existing store keeps its own: a different value is refused.
   std::optional<double> particleSpacing;
   std::uint32_t brickSize = 64;        ///< 32, 64 or 128
   std::uint64_t memoryBudget = kDefaultMemoryBudget;  ///< bytes

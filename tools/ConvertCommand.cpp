@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <memory>
+#include <optional>
 
 #include "core/AtomicFile.h"
 #include "core/Error.h"
@@ -22,6 +23,7 @@ struct ConvertArgs {
   std::vector<std::string> grids;
   double cellSize = 0;
   std::uint32_t resolution = 0;  ///< 0: not given
+  std::optional<double> particleSpacing;
   std::uint32_t brickSize = 64;
   std::string domain;
   std::string mem = "4G";
@@ -41,6 +43,7 @@ void runConvert(const ConvertArgs& a) {
   ConvertOptions options;
   if (a.cellSize != 0) options.cellSize = a.cellSize;
   if (a.resolution != 0) options.resolution = a.resolution;
+  options.particleSpacing = a.particleSpacing;
   options.brickSize = a.brickSize;
   if (!a.domain.empty()) options.domain = parseBox("--domain", a.domain);
   options.memoryBudget = parseBytes("--mem", a.mem);
@@ -115,6 +118,10 @@ void addConvertCommand(CLI::App& app) {
   cmd->add_option("--brick-size", args->brickSize, "Cells per brick edge")
       ->check(CLI::IsMember({32, 64, 128}))
       ->capture_default_str();
+  cmd->add_option("--particle-spacing", args->particleSpacing,
+                  "Particle spacing in world units, e.g. the simulation's particle separation (default: measured "
+                  "on the first frame, an extra read; 0: unknown, not measured)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--domain", args->domain, "x0,y0,z0,x1,y1,z1 in world units (default: bounds of the data)");
   cmd->add_option("--mem", args->mem, "Memory budget, e.g. 512M, 8G")->capture_default_str();
   cmd->add_option("--attribute", args->attribute,

@@ -180,6 +180,7 @@ struct ConvertFarmArgs {
   std::string domain;
   double cellSize = 0;
   std::uint32_t resolution = 0;
+  std::optional<double> particleSpacing;
   std::uint32_t brickSize = 0;
   std::string attribute;
   std::string kindAttribute;
@@ -233,6 +234,7 @@ void runFarmConvert(const ConvertFarmArgs& a) {
     };
     if (a.cellSize > 0) prepareOnly("--cell-size", formatNumber17(a.cellSize));
     if (a.resolution > 0) prepareOnly("--resolution", std::to_string(a.resolution));
+    if (a.particleSpacing) prepareOnly("--particle-spacing", formatNumber17(*a.particleSpacing));
     if (a.brickSize > 0) prepareOnly("--brick-size", std::to_string(a.brickSize));
     if (!a.attribute.empty()) prepareOnly("--attribute", a.attribute);
     plan.convertArgs.insert(plan.convertArgs.end(), {"--zstd-level", std::to_string(a.zstdLevel)});
@@ -367,6 +369,9 @@ void addFarmCommand(CLI::App& app) {
   c->add_option("--resolution", convert->resolution, "Cells along the longest domain axis")
       ->check(CLI::PositiveNumber)
       ->excludes(cell);
+  c->add_option("--particle-spacing", convert->particleSpacing,
+                "Particle spacing in world units (default: measured, as convert; 0: unknown)")
+      ->check(CLI::NonNegativeNumber);
   c->add_option("--brick-size", convert->brickSize, "Cells per brick edge")->check(CLI::IsMember({32, 64, 128}));
   c->add_option("--attribute", convert->attribute, "Per-particle attribute to store, as for convert");
   c->add_option("--kind-attribute", convert->kindAttribute, "Particle type attribute (auto, none or a name), as for convert");

@@ -93,6 +93,13 @@ TEST_F(FarmCommand, DryRunPrintsEveryScriptAndWritesNothing) {
   ASSERT_EQ(kinds.exitCode, 0) << kinds.output;
   EXPECT_NE(kinds.output.find("--prepare --domain \"$domain\" --kind-attribute none"), std::string::npos) << kinds.output;
   EXPECT_NE(kinds.output.find("--append --kind-attribute none"), std::string::npos) << kinds.output;
+  // A given particle spacing goes to the header's convert only: the frames' keep the store's.
+  const CommandRun spacing = runFlipscope("farm convert " + scenario.path("in/in_####.bin") + " -o " +
+                                          scenario.path("s") + " --particle-spacing 0.125 --dry-run");
+  ASSERT_EQ(spacing.exitCode, 0) << spacing.output;
+  EXPECT_NE(spacing.output.find("--prepare --domain \"$domain\" --particle-spacing 0.125"), std::string::npos)
+      << spacing.output;
+  EXPECT_EQ(spacing.output.find("--append --particle-spacing"), std::string::npos) << spacing.output;
 }
 
 TEST_F(FarmCommand, BadRequestsAreRefusedNamingWhatIsWrong) {

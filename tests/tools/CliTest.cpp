@@ -100,6 +100,62 @@ TEST_F(Cli, DefaultConvertOfMantaflowMakesOneCellPerParticleSpacingAndInfoShowsI
   EXPECT_NEAR(coarse["particle_spacing_cells"].get<double>(), spacing / 0.1, 1e-12);
 }
 
+TEST_F(Cli, AGivenParticleSpacingIsRecordedAndSkipsItsReadAndWithADomainConvertReadsOnce) {
+  ASSERT_EQ(runFlipscope("synth -o " + path("s.ply") + " --particles 30k --velocity").exitCode, 0);
+  CommandRun measured = runFlipscope("convert " + path("s.ply") + " -o " + path("measured") + " --cell-size 0.02");
+  ASSERT_EQ(measured.exitCode, 0) << measured.output;
+  EXPECT_NE(measured.output.find("particle spacing of frame 0"), std::string::npos) << measured.output;
+  const auto j = nlohmann::json::parse(runFlipscope("info --json " + path("measured")).output);
+  const double spacing = j["particle_spacing"].get<double>();
+  ASSERT_GT(spacing, 0.0);
+  char exact[32];
+  std::snprintf(exact, sizeof exact, "%.17g", spacing);
+
+  // Given the spacing it measured: the same store, without the spacing's read of the frame.
+  CommandRun given = runFlipscope("convert " + path("s.ply") + " -o " + path("given") +
+                                  " --cell-size 0.02 --particle-spacing " + exact);
+  ASSERT_EQ(given.exitCode, 0) << given.output;
+  EXPECT_EQ(given.output.find("particle spacing of frame"), std::string::npos) << given.output;
+  EXPECT_NE(given.output.find("scan bounds"), std::string::npos) << "the domain still takes a read: " << given.output;
+  EXPECT_NE(given.output.find("from --particle-spacing"), std::string::npos) << given.output;
+  EXPECT_EQ(frameBytesWithoutStoreId(dir / "given" / "frame_000000.fsf"),
+            frameBytesWithoutStoreId(dir / "measured" / "frame_000000.fsf"));
+
+  // With the domain as well, the frame is read once: by the binning.
+  std::string domain;
+  for (const auto& v : j["origin"]) domain += std::to_string(v.get<double>() - 0.01) + ",";
+  domain += "1.1,1.1,1.1";
+  CommandRun once = runFlipscope("convert " + path("s.ply") + " -o " + path("once") + " --domain " + domain +
+                                 " --cell-size 0.02 --particle-spacing " + exact);
+  ASSERT_EQ(once.exitCode, 0) << once.output;
+  EXPECT_EQ(once.output.find("particle spacing of frame"), std::string::npos) << once.output;
+  EXPECT_EQ(once.output.find("scan bounds"), std::string::npos) << once.output;
+  const auto k = nlohmann::json::parse(runFlipscope("info --json " + path("once")).output);
+  EXPECT_EQ(k["particle_spacing"].get<double>(), spacing);
+  EXPECT_EQ(k["frames"][0]["particles"], j["frames"][0]["particles"]);
+
+  // 0: unknown, not measured; the cell size then falls back to the default resolution.
+  CommandRun unknown = runFlipscope("convert " + path("s.ply") + " -o " + path("unknown") + " --particle-spacing 0");
+  ASSERT_EQ(unknown.exitCode, 0) << unknown.output;
+  EXPECT_NE(unknown.output.find("particle spacing unknown (not measured (--particle-spacing 0))"), std::string::npos)
+      << unknown.output;
+  EXPECT_NE(unknown.output.find("1024 cells along the longest axis"), std::string::npos) << unknown.output;
+  EXPECT_TRUE(
+      nlohmann::json::parse(runFlipscope("info --json " + path("unknown")).output)["particle_spacing"].is_null());
+
+  // An existing store keeps its spacing: another is refused, naming both.
+  CommandRun other = runFlipscope("convert " + path("s.ply") + " -o " + path("measured") + " --particle-spacing 0.5");
+  EXPECT_EQ(other.exitCode, 2) << other.output;
+  EXPECT_NE(other.output.find("the store's particle spacing is"), std::string::npos) << other.output;
+  EXPECT_NE(other.output.find("not 0.5 (--particle-spacing)"), std::string::npos) << other.output;
+  CommandRun same =
+      runFlipscope("convert " + path("s.ply") + " -o " + path("measured") + " --particle-spacing " + exact);
+  EXPECT_EQ(same.exitCode, 0) << same.output;
+  CommandRun negative = runFlipscope("convert " + path("s.ply") + " -o " + path("neg") + " --particle-spacing -1");
+  EXPECT_EQ(negative.exitCode, 2) << negative.output;
+  EXPECT_FALSE(fs::exists(dir / "neg"));
+}
+
 TEST_F(Cli, TheStoresUpAxisOrientsRenderUnlessGivenUp) {
   const fs::path vdb = flipscope::testing::mantaflowFile("data", "fluid_data_0030.vdb");
   CommandRun inspect = runFlipscope("inspect '" + vdb.string() + "'");
