@@ -64,15 +64,18 @@ EnvironmentMap loadEnvironmentMap(const std::filesystem::path& path) {
 
 /// The images and stage objects, created once the screen device exists.
 struct FramePipeline::Stages {
-  ScreenImage hits = 0;           ///< kVec4PerHit vec4 per pixel: the ray-caster's, adopted
-  ScreenImage rawGbuffer = 0;     ///< depth, mask, thickness, attribute
-  ScreenImage gbuffer = 0;        ///< the same with the thickness blurred
+  // Only the images the look's stages write exist (kNoImage otherwise): each is a frame of
+  // memory, and on the CPU its first touch is most of a cold frame's screen time.
+  static constexpr ScreenImage kNoImage = ~ScreenImage(0);
+  ScreenImage hits = 0;               ///< kVec4PerHit vec4 per pixel: the ray-caster's, adopted
+  ScreenImage rawGbuffer = kNoImage;  ///< depth, mask, thickness, attribute; with the thickness only
+  ScreenImage gbuffer = 0;            ///< the same with the thickness blurred
   ScreenImage sphereNormals = 0;
-  ScreenImage smoothed = 0;       ///< the filter's output; see smoothedDepth()
-  ScreenImage normals = 0;
+  ScreenImage smoothed = kNoImage;  ///< the filter's output, when it changes the depth; see smoothedDepth()
+  ScreenImage normals = kNoImage;   ///< reconstructed from the smoothed depth; not for lit spheres
   ScreenImage shaded = 0;
-  ScreenImage display = 0;        ///< progressive: what the viewer shows
-  ScreenImage shown = 0;          ///< progressive: what it showed before
+  ScreenImage display = kNoImage;  ///< progressive: what the viewer shows; made by begin()
+  ScreenImage shown = kNoImage;    ///< progressive: what it showed before
   std::unique_ptr<SurfaceFilter> filter;
   std::unique_ptr<SurfaceShading> shading;
   bool thickness = false;         ///< the ray-caster traces the thickness (liquid shading)
@@ -81,6 +84,8 @@ struct FramePipeline::Stages {
   std::vector<glm::vec4> downloaded[4];  ///< GPU: the images readOutput() reads back, kept
   /// The smoothed depth: the G-buffer itself when the filter keeps the depth (not run).
   ScreenImage smoothedDepth() const { return filter->keepsDepth() ? gbuffer : smoothed; }
+  /// The image's normals: the spheres' for lit spheres, else those of the smoothed surface.
+  ScreenImage imageNormals() const { return litSpheres ? sphereNormals : normals; }
 };
 
 FramePipeline::FramePipeline(BrickStore store, DeviceChoice device, const RenderSettings& settings,
@@ -153,18 +158,17 @@ void FramePipeline::init(std::shared_ptr<BrickSource> source,
         },
         kVec4PerHit);
   }
-  const std::vector<ScreenImage> images = mScreen->createFrameImages(8);
-  s.rawGbuffer = images[0];
-  s.gbuffer = images[1];
-  s.sphereNormals = images[2];
-  s.smoothed = images[3];
-  s.normals = images[4];
-  s.shaded = images[5];
-  s.display = images[6];
-  s.shown = images[7];
-  mScreen->clear(s.display);
-  mScreen->clear(s.shown);
   s.filter = createSurfaceFilter(mSurface.smoothing);
+  const bool smoothing = !s.filter->keepsDepth();
+  const std::vector<ScreenImage> images =
+      mScreen->createFrameImages(3 + std::size_t(s.thickness) + std::size_t(smoothing) + std::size_t(!s.litSpheres));
+  auto next = images.begin();
+  if (s.thickness) s.rawGbuffer = *next++;
+  s.gbuffer = *next++;
+  s.sphereNormals = *next++;
+  if (smoothing) s.smoothed = *next++;
+  if (!s.litSpheres) s.normals = *next++;
+  s.shaded = *next++;
   s.shading = std::make_unique<SurfaceShading>(*mScreen, mSurface.shading, map);
 }
 
@@ -210,6 +214,7 @@ const FrameOutput& FramePipeline::render(int frame, const Camera& camera, int di
 }
 
 void FramePipeline::begin(int frame, const Camera& camera, int direction) {
+  makeDisplayImages();
   mRenderer->begin(frame, camera, direction);
   mFrame = frame;
   mCamera = camera;
@@ -231,11 +236,26 @@ FramePipeline::Progress FramePipeline::advance(double budgetMs) {
   return progress;
 }
 
-std::vector<glm::vec4> FramePipeline::downloadDisplay() { return mScreen->download(mStages->display); }
+void FramePipeline::makeDisplayImages() {
+  Stages& s = *mStages;
+  if (s.display != Stages::kNoImage) return;
+  const std::vector<ScreenImage> images = mScreen->createFrameImages(2);
+  s.display = images[0];
+  s.shown = images[1];
+  mScreen->clear(s.display);
+  mScreen->clear(s.shown);
+}
 
-const gl::Buffer* FramePipeline::displayBuffer() const {
+std::vector<glm::vec4> FramePipeline::downloadDisplay() {
+  makeDisplayImages();
+  return mScreen->download(mStages->display);
+}
+
+const gl::Buffer* FramePipeline::displayBuffer() {
   auto* gpu = dynamic_cast<GpuScreenDevice*>(mScreen.get());
-  return gpu ? &gpu->buffer(mStages->display) : nullptr;
+  if (!gpu) return nullptr;
+  makeDisplayImages();
+  return &gpu->buffer(mStages->display);
 }
 
 void FramePipeline::shade(int frame, const Camera& camera, StageTimes& stages) {
@@ -259,7 +279,7 @@ void FramePipeline::shade(int frame, const Camera& camera, StageTimes& stages) {
   const FrameStats stats =
       mRenderer->source().carriesAttributes() ? mRenderer->source().frame(frame)->stats : FrameStats{};
   s.shading->setFrameAttributeRange(stats.attributeMin, stats.attributeMax);
-  timed(stages.shading, [&] { s.shading->shade(device, s.gbuffer, s.normals, s.sphereNormals, s.shaded); });
+  timed(stages.shading, [&] { s.shading->shade(device, s.gbuffer, s.imageNormals(), s.sphereNormals, s.shaded); });
   s.shadedReadOut = false;
 }
 
@@ -292,7 +312,7 @@ const FrameOutput& FramePipeline::readOutput() {
   };
   const auto gbuffer = read(s.gbuffer, 0);
   const auto smoothed = read(s.smoothedDepth(), 1);
-  const auto normals = read(s.litSpheres ? s.sphereNormals : s.normals, 2);
+  const auto normals = read(s.imageNormals(), 2);
   const std::size_t n = gbuffer.size();
   constexpr float kInf = std::numeric_limits<float>::infinity();
   image.depth.resize(n);

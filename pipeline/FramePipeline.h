@@ -107,7 +107,7 @@ class FramePipeline {
   std::vector<glm::vec4> downloadDisplay();
   /// The display image's shader storage buffer (vec4 per pixel) in the pipeline's OpenGL
   /// context; nullptr when the pipeline runs on the CPU.
-  const gl::Buffer* displayBuffer() const;
+  const gl::Buffer* displayBuffer();
 
   FrameRenderer& renderer() { return *mRenderer; }
   const FrameRenderer& renderer() const { return *mRenderer; }
@@ -122,6 +122,8 @@ class FramePipeline {
             const RenderSettings& settings);
   /// The screen stages over the ray-caster's current hits, into the stages' images.
   void shade(int frame, const Camera& camera, StageTimes& stages);
+  /// The progressive display's images, made (cleared) on first use: a batch render has none.
+  void makeDisplayImages();
   std::unique_ptr<FrameRenderer> mRenderer;
   std::unique_ptr<ScreenDevice> mScreen;  // destroyed before the renderer's GL context
   std::unique_ptr<Stages> mStages;

@@ -80,6 +80,15 @@ void runStage(const FrameStageArgs& a) {
                          {"first_image_s", firstSeconds},
                          {"bricks_touched", firstStats.bricksUploaded},
                          {"frame_bricks", firstStats.frameBricks},
+                         {"first_frame",  // where the cold frame's time goes (FrameRenderer's RenderStats)
+                          {{"passes", firstStats.passes},
+                           {"trace_ms", firstStats.traceMs},
+                           {"stream_ms", firstStats.streamMs},
+                           {"upload_ms", firstStats.uploadMs},
+                           {"foam_ms", firstStats.foamMs},
+                           {"render_ms", firstStats.totalMs},
+                           {"image_ms", first.stages.trace + first.stages.gbuffer + first.stages.smoothing +
+                                            first.stages.normals + first.stages.shading + first.stages.readback}}},
                          {"warm_frame_ms", warm},
                          {"warm_trace_ms", warmTrace},
                          {"warm_stages_ms", warmStages},

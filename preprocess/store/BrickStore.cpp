@@ -690,10 +690,10 @@ std::shared_ptr<const FrameIndex> BrickStore::frame(int frame) const {
   return mShared->indices.emplace(frame, index).first->second;
 }
 
-std::vector<std::byte> BrickStore::readPayload(const FrameIndex& frame, std::uint32_t brickIndex) const {
+UninitializedVector<std::byte> BrickStore::readPayload(const FrameIndex& frame, std::uint32_t brickIndex) const {
   FLIPSCOPE_CHECK(brickIndex < frame.bricks.size(), brickIndex << " of " << frame.bricks.size());
   const BrickRecord& b = frame.bricks[brickIndex];
-  std::vector<std::byte> payload(b.bytes);
+  UninitializedVector<std::byte> payload(b.bytes);  // pread fills it: no memset first
   FileHandle handle(frame.file);
   readAt(handle.fd(), frame.file, b.offset, payload.data(), payload.size(), "brick payload");
   if (checksum64(payload) != b.checksum)

@@ -221,7 +221,7 @@ class BrickStore {
   /// compressed (decodeBrick's readAttributes). Thread safe.
   DecodedBrick readBrick(const FrameIndex& frame, std::uint32_t brickIndex, bool attributes = true) const;
   /// Reads one brick's compressed payload and verifies its checksum. Thread safe.
-  std::vector<std::byte> readPayload(const FrameIndex& frame, std::uint32_t brickIndex) const;
+  UninitializedVector<std::byte> readPayload(const FrameIndex& frame, std::uint32_t brickIndex) const;
 
   /// The range of the attribute over the store's frames (those with particles): recorded in
   /// store.fsh since version 4 (a frame converted again widens it, never narrows it), gathered
