@@ -74,7 +74,7 @@ struct FramePipeline::Stages {
   ScreenImage smoothed = kNoImage;  ///< the filter's output, when it changes the depth; see smoothedDepth()
   ScreenImage normals = kNoImage;   ///< reconstructed from the smoothed depth; not for lit spheres
   ScreenImage shaded = 0;
-  ScreenImage display = kNoImage;  ///< progressive: what the viewer shows; made by begin()
+  ScreenImage display = kNoImage;  ///< progressive: what the viewer shows; see makeDisplayImages()
   ScreenImage shown = kNoImage;    ///< progressive: what it showed before
   std::unique_ptr<SurfaceFilter> filter;
   std::unique_ptr<SurfaceShading> shading;

@@ -1058,8 +1058,9 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
                          " (--cell-size); convert into a new store to change them");
       if (options.particleSpacing && *options.particleSpacing != header.particleSpacing)
         throw InputError(storeDir.string() + ": the store's particle spacing is " +
-                         formatExact(header.particleSpacing) + " world units, not " +
-                         formatExact(*options.particleSpacing) +
+                         (header.particleSpacing > 0 ? formatExact(header.particleSpacing) + " world units"
+                                                     : std::string("unknown (0)")) +
+                         ", not " + formatExact(*options.particleSpacing) +
                          " (--particle-spacing); convert into a new store to change it");
       report.cellSizeOrigin = "kept from the existing store";
       report.spacingOrigin = "the existing store";

@@ -23,8 +23,8 @@
 // Cell size: --cell-size, else longest domain axis / --resolution, else (neither given) one cell
 // per particle spacing of the first frame (ParticleSpacing.h), falling back to
 // kDefaultResolution cells along the longest axis, with a warning, when the spacing is unknown
-// or the grid would exceed kMaxCellsPerAxis. The spacing is measured and recorded in the
-// store header either way (StoreHeader::particleSpacing).
+// or the grid would exceed kMaxCellsPerAxis. The spacing (ConvertOptions::particleSpacing, else
+// measured) is recorded in the store header either way (StoreHeader::particleSpacing).
 //
 // Concurrent writers: any number of convert() calls, in any processes and on any machines of a
 // shared filesystem, may add frames to one store at once (StoreLock.h). They must agree on the

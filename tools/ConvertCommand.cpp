@@ -120,7 +120,7 @@ void addConvertCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--particle-spacing", args->particleSpacing,
                   "Particle spacing in world units, e.g. the simulation's particle separation (default: measured "
-                  "on the first frame, an extra read; 0: unknown, not measured)")
+                  "on the first frame; with --domain too, convert reads each frame once; 0: unknown, not measured)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--domain", args->domain, "x0,y0,z0,x1,y1,z1 in world units (default: bounds of the data)");
   cmd->add_option("--mem", args->mem, "Memory budget, e.g. 512M, 8G")->capture_default_str();

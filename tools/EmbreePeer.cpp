@@ -107,6 +107,7 @@ void runStage(const EmbreeStageArgs& a) {
   if (!(a.request.radius > 0)) throw InputError("--radius: a positive sphere radius in world units");
   const Camera camera = loadCamera(a.cameraFile);
   // The particles, as Embree's sphere points want them: x, y, z, radius.
+  const auto readStart = Clock::now();
   std::vector<glm::vec4> spheres;
   {
     auto source = openParticleFile(a.particles, ReadOptions{.velocity = false});
@@ -115,6 +116,7 @@ void runStage(const EmbreeStageArgs& a) {
       for (const glm::vec3& p : chunk.positions)
         if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) spheres.emplace_back(p, a.request.radius);
   }
+  const double read = secondsSince(readStart);
   EmbreeMemory memory;
   const auto start = Clock::now();
   RTCDevice device = rtcNewDevice(nullptr);
@@ -154,6 +156,7 @@ void runStage(const EmbreeStageArgs& a) {
   std::snprintf(version, sizeof version, "Embree %d.%d.%d", RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH);
   const nlohmann::json j{{"version", version},
                          {"particles", spheres.size()},
+                         {"read_s", read},
                          {"build_s", build},
                          {"first_frame_s", first},
                          {"warm_frame_ms", warm},
@@ -192,6 +195,7 @@ EmbreeStageResult runEmbreeStage(const EmbreeStageRequest& request, const fs::pa
   EmbreeStageResult r;
   r.version = j["version"].get<std::string>();
   r.particles = j["particles"].get<std::uint64_t>();
+  r.readSeconds = j["read_s"].get<double>();
   r.buildSeconds = j["build_s"].get<double>();
   r.firstFrameSeconds = j["first_frame_s"].get<double>();
   r.warmFrameMs = j["warm_frame_ms"].get<std::vector<double>>();

@@ -28,6 +28,7 @@ struct EmbreeStageRequest {
 struct EmbreeStageResult {
   std::string version;            ///< "Embree 3.13.5"
   std::uint64_t particles = 0;
+  double readSeconds = 0;         ///< the particle file read into the sphere array (before the build)
   double buildSeconds = 0;        ///< scene committed: the BVH built
   double firstFrameSeconds = 0;   ///< build + first frame
   std::vector<double> warmFrameMs;

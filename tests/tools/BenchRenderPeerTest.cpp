@@ -47,6 +47,14 @@ TEST(BenchRenderPeer, EmbreeAndFlipscopeRenderTheSameParticlesWithTheSameCamera)
   EXPECT_NEAR(peer["flipscope_convert_and_first_image_s"].get<double>(),
               peer["flipscope_convert_s"].get<double>() + peer["flipscope_first_image_s"].get<double>(), 1e-9);
   EXPECT_GT(peer["flipscope_render_peak_rss_bytes"].get<double>(), 0.0);
+  // The same convert with the particle spacing given, and its store's first image.
+  EXPECT_GT(peer["flipscope_spacing_given_convert_s"].get<double>(), 0.0);
+  EXPECT_GT(peer["flipscope_spacing_given_first_image_s"].get<double>(), 0.0);
+  EXPECT_NEAR(peer["flipscope_spacing_given_convert_and_first_image_s"].get<double>(),
+              peer["flipscope_spacing_given_convert_s"].get<double>() +
+                  peer["flipscope_spacing_given_first_image_s"].get<double>(),
+              1e-9);
+  EXPECT_FALSE(std::filesystem::exists(dir / "peer_spacing_given.store")) << "removed after its image";
   if (peer["embree"].is_null()) {  // built without Embree (it is optional)
     ASSERT_EQ(std::getenv("FLIPSCOPE_REQUIRE_EMBREE"), nullptr) << "CI installs libembree-dev: " << run.output;
     GTEST_SKIP() << "this flipscope is built without Embree (Debian: libembree-dev)";
@@ -55,6 +63,7 @@ TEST(BenchRenderPeer, EmbreeAndFlipscopeRenderTheSameParticlesWithTheSameCamera)
   std::uint32_t w = 0, h = 0;
   EXPECT_EQ(embree["version"].get<std::string>().rfind("Embree 3.", 0), 0u);
   EXPECT_GE(embree["build_and_first_frame_s"].get<double>(), embree["build_s"].get<double>());
+  EXPECT_GT(embree["read_s"].get<double>(), 0.0);
   EXPECT_GT(embree["warm_frame_ms"].get<double>(), 0.0);
   EXPECT_GT(embree["embree_bytes"].get<double>(), 0.0);
 

@@ -148,6 +148,11 @@ TEST_F(Cli, AGivenParticleSpacingIsRecordedAndSkipsItsReadAndWithADomainConvertR
   EXPECT_EQ(other.exitCode, 2) << other.output;
   EXPECT_NE(other.output.find("the store's particle spacing is"), std::string::npos) << other.output;
   EXPECT_NE(other.output.find("not 0.5 (--particle-spacing)"), std::string::npos) << other.output;
+  CommandRun unknownOther =
+      runFlipscope("convert " + path("s.ply") + " -o " + path("unknown") + " --particle-spacing 0.5");
+  EXPECT_EQ(unknownOther.exitCode, 2) << unknownOther.output;
+  EXPECT_NE(unknownOther.output.find("particle spacing is unknown (0), not 0.5"), std::string::npos)
+      << unknownOther.output;
   CommandRun same =
       runFlipscope("convert " + path("s.ply") + " -o " + path("measured") + " --particle-spacing " + exact);
   EXPECT_EQ(same.exitCode, 0) << same.output;

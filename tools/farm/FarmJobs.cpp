@@ -90,8 +90,8 @@ std::vector<FarmJob> planJobs(const FarmPlan& plan, const std::vector<int>& fram
     }
     if (prepare) {
       FarmJob job = makeJob(plan, "prepare", {});
-      // The header as a serial convert chooses it: the domain, and the particle spacing (and the
-      // attribute) of the first frame that could be read.
+      // The header as a serial convert chooses it: the domain, and the particle spacing (unless
+      // given: --particle-spacing) and the attribute of the first frame that could be read.
       std::string body;
       std::string domain;
       if (plan.boundsPass) {
