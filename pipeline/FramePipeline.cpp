@@ -305,6 +305,13 @@ const FrameOutput& FramePipeline::readOutput() {
   } else {
     device.downloadInto(s.shaded, image.rgba);
   }
+  if (mOutputLayers == OutputLayers::Colour) {
+    for (auto* layer : {&image.depth, &image.unsmoothedDepth, &image.thickness, &image.attribute}) layer->clear();
+    image.normal.clear();
+    image.foam.clear();
+    image.attributeName.clear();
+    return out;
+  }
   auto read = [&](ScreenImage handle, int slot) -> std::span<const glm::vec4> {
     if (cpu) return cpu->pixels(handle);
     device.downloadInto(handle, s.downloaded[slot]);

@@ -58,10 +58,15 @@ struct FrameOutput {
   /// --foam volume: its premultiplied colour and opacity, composited into rgba); attribute
   /// (when the store has one: the value of the nearest hit cell, the largest of its particles'
   /// 16-bit values, in the attribute's units; 0 on the background), named after the attribute.
+  /// With OutputLayers::Colour, rgba alone: the other layers are empty.
   RenderImage image;
   RenderStats stats;   ///< the ray-caster's
   StageTimes stages;
 };
+
+/// What readOutput() reads back: every layer of the image (an EXR keeps them), or the colour
+/// alone (a PNG): at 3840x2160, 330 MB of layers and the pass that fills them.
+enum class OutputLayers { All, Colour };
 
 class FramePipeline {
  public:
@@ -103,6 +108,8 @@ class FramePipeline {
   /// The images of the last shaded frame (begin()'s frame), as render() returns them (and as
   /// long).
   const FrameOutput& readOutput();
+  /// What render() and readOutput() read back from now on (OutputLayers::All at first).
+  void setOutputLayers(OutputLayers layers) { mOutputLayers = layers; }
   /// The display image, rgba per pixel, row 0 at the top (zeros before the first advance()).
   std::vector<glm::vec4> downloadDisplay();
   /// The display image's shader storage buffer (vec4 per pixel) in the pipeline's OpenGL
@@ -128,6 +135,7 @@ class FramePipeline {
   std::unique_ptr<ScreenDevice> mScreen;  // destroyed before the renderer's GL context
   std::unique_ptr<Stages> mStages;
   FrameOutput mOutput;  ///< the last read back, its images reused frame to frame
+  OutputLayers mOutputLayers = OutputLayers::All;
   SurfaceSettings mSurface;
   int mFrame = 0;          ///< of the last begin() or render()
   Camera mCamera;

@@ -267,7 +267,7 @@ void writePng(const std::filesystem::path& path, const RenderImage& image) {
   reportingErrors<OutputError>(path, [&] { writeFileAtomically(path, encoded); });
 }
 
-bool keepsAttributeChannel(const std::filesystem::path& path) { return lowerExtension(path) == ".exr"; }
+bool keepsImageLayers(const std::filesystem::path& path) { return lowerExtension(path) == ".exr"; }
 
 bool isImagePath(const std::filesystem::path& path) {
   const std::string extension = lowerExtension(path);

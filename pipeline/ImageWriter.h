@@ -78,9 +78,10 @@ struct ExrContents {
 /// channels). For tests and checks. Throws FileError naming `path`.
 ExrContents readExr(const std::filesystem::path& path);
 
-/// Whether writeImage keeps the image's attribute channel in a file named `path`: an EXR does,
-/// a PNG holds the final look only.
-bool keepsAttributeChannel(const std::filesystem::path& path);
+/// Whether writeImage keeps the image's layers beyond its colour (depth, normals, thickness,
+/// foam, the attribute channel) in a file named `path`: an EXR does, a PNG holds the final look
+/// only.
+bool keepsImageLayers(const std::filesystem::path& path);
 
 /// sRGB encoding (IEC 61966-2-1) of a linear value clamped to [0, 1], as an 8-bit code
 /// (rounded to nearest). NaN gives 0. From a table: the code linearToSrgb8Formula gives.

@@ -61,11 +61,17 @@ ScreenImage CpuScreenDevice::adoptFramePixels(std::function<std::span<const glm:
 CpuScreenDevice::Image& CpuScreenDevice::target(ScreenImage handle) {
   Image& target = image(handle);
   FLIPSCOPE_CHECK(!target.adopted, "screen image " << handle << " is adopted: an input only");
+  // A frame image whose storage went to exchangePixels() gets its pixels back here.
+  const std::size_t elements = std::size_t(width()) * height() * target.perPixel;
+  if (target.perPixel && target.data.size() != elements) target.data.assign(elements, glm::vec4(0));
   return target;
 }
 
 std::span<const glm::vec4> CpuScreenDevice::read(ScreenImage handle) {
   const Image& source = image(handle);
+  FLIPSCOPE_CHECK(
+      source.adopted || !source.perPixel || source.data.size() == std::size_t(width()) * height() * source.perPixel,
+      "screen image " << handle << " read after exchangePixels() before a pass wrote it");
   return source.adopted ? source.adopted() : std::span<const glm::vec4>(source.data);
 }
 
@@ -74,7 +80,7 @@ std::span<glm::vec4> CpuScreenDevice::pixels(ScreenImage handle) { return target
 void CpuScreenDevice::exchangePixels(ScreenImage handle, std::vector<glm::vec4>& pixels) {
   Image& image = target(handle);
   FLIPSCOPE_CHECK(image.perPixel > 0, "screen image " << handle << " is not a frame image");
-  pixels.resize(image.data.size());
+  if (pixels.size() != image.data.size()) pixels.clear();  // sized by target() when written
   image.data.swap(pixels);
 }
 

@@ -29,8 +29,10 @@ class CpuScreenDevice : public ScreenDevice {
 
   /// The image's elements in place (no copy), for callers on the CPU; not of an adopted image.
   std::span<glm::vec4> pixels(ScreenImage image);
-  /// Moves the frame image's pixels into `pixels` (no copy) and takes the vector's storage, sized
-  /// to the image, in their place: its contents are undefined until a pass writes the image.
+  /// Moves the frame image's pixels into `pixels` (no copy) and takes the vector's storage in
+  /// their place: its contents are undefined until a pass writes the image. Storage of another
+  /// size (none, the first time) is not sized here but when the image is next written: a single
+  /// frame's render never allocates it.
   void exchangePixels(ScreenImage image, std::vector<glm::vec4>& pixels);
   /// An image that passes read where `pixels` says it is, at each run (the CPU ray-caster's
   /// hits, `perPixel` vec4 a pixel): nothing is copied. It is an input only.

@@ -45,11 +45,13 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
                      " needs '#' in the output name (e.g. out_####.exr)");
 
   RenderRequest request = job;
-  request.attributeOutput = keepsAttributeChannel(job.output);  // a PNG's look may need none
+  const bool layers = keepsImageLayers(job.output);
+  request.attributeOutput = layers;  // a PNG's look may need none
   const auto [settings, surface] = resolve(request, store);
   const StoreHeader& header = store.header();
   std::string fallback;
   FramePipeline pipeline(store, job.device, settings, surface, &fallback);
+  pipeline.setOutputLayers(layers ? OutputLayers::All : OutputLayers::Colour);
   FrameRenderer& renderer = pipeline.renderer();
   if (!job.quiet) {
     if (!fallback.empty()) std::fprintf(stderr, "render: using the CPU ray-caster: %s\n", fallback.c_str());

@@ -100,6 +100,30 @@ TEST(FramePipeline, TheOutputReadsTheSameAgainAndAfterTheNextFrame) {
   EXPECT_EQ(pipeline.readOutput().image.rgba, first);
 }
 
+TEST(FramePipeline, TheColourAloneIsTheColourOfAllLayersAndLeavesTheOthersEmpty) {
+  testing::TempDir dir("pipeline");
+  const testing::BallScene ball;
+  FramePipeline pipeline(ball.makeStore(dir.path() / "store"), DeviceChoice::Cpu, ball.settings(), SurfaceSettings{});
+  const RenderImage all = pipeline.render(0, ball.camera()).image;
+  const std::size_t n = std::size_t(all.width) * all.height;
+  ASSERT_EQ(all.depth.size(), n);
+  ASSERT_EQ(all.normal.size(), n);
+  ASSERT_EQ(all.thickness.size(), n);
+  pipeline.setOutputLayers(OutputLayers::Colour);
+  const RenderImage colour = pipeline.render(0, ball.camera()).image;
+  EXPECT_EQ(colour.width, all.width);
+  EXPECT_EQ(colour.height, all.height);
+  EXPECT_EQ(colour.rgba, all.rgba);
+  EXPECT_TRUE(colour.depth.empty() && colour.unsmoothedDepth.empty() && colour.thickness.empty() &&
+              colour.normal.empty() && colour.foam.empty() && colour.attribute.empty());
+  pipeline.setOutputLayers(OutputLayers::All);
+  const RenderImage again = pipeline.readOutput().image;
+  EXPECT_EQ(again.rgba, all.rgba);
+  EXPECT_EQ(again.depth, all.depth);
+  EXPECT_EQ(again.normal, all.normal);
+  EXPECT_EQ(again.thickness, all.thickness);
+}
+
 TEST(FramePipeline, ShadingModesGiveDifferentLooks) {
   const FrameOutput liquid = renderBall("rof", ShadingMode::Liquid);
   const FrameOutput spheres = renderBall("rof", ShadingMode::Spheres);
