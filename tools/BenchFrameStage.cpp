@@ -44,12 +44,13 @@ void runStage(const FrameStageArgs& a) {
     request.surface.shading.mode = ShadingMode::Spheres;
     request.settings.foam.mode = FoamMode::Keep;  // as the peer: every particle a sphere
   }
-  // As `render` to a PNG: the images this stage keeps are looked at, and their EXR compared by
-  // depth; a look that does not colour by the attribute reads none.
+  // As `render` to a PNG: a look that does not colour by the attribute reads none (the EXR this
+  // stage writes to compare depths has no attribute channel).
   request.attributeOutput = false;
   const ResolvedRender look = resolve(request, store);
   FramePipeline pipeline(std::move(store), parseDeviceChoice("--device", a.request.device), look.settings,
                          look.surface);
+  pipeline.setOutputLayers(OutputLayers::Colour);  // as `render` to a PNG, and as the Embree peer's image
   const Camera camera = a.cameraFile.empty() ? defaultRenderCamera(pipeline.renderer().source(), frames.front(),
                                                                    frames.front(), width, height, look.surface.up)
                                              : loadCamera(a.cameraFile);
@@ -57,9 +58,11 @@ void runStage(const FrameStageArgs& a) {
   const double firstSeconds = secondsSince(start);
   const RenderStats firstStats = first.stats;  // the warm frames reuse the output
   const StageTimes firstStages = first.stages;
-  if (!a.image.empty()) {  // to look at, and with its depth (EXR) to compare
+  if (!a.image.empty()) {  // to look at, and with its depth (EXR) to compare: read again, untimed
     writeImage(a.image, first.image);
-    writeImage(fs::path(a.image).replace_extension(".exr"), first.image);
+    pipeline.setOutputLayers(OutputLayers::All);
+    writeImage(fs::path(a.image).replace_extension(".exr"), pipeline.readOutput().image);
+    pipeline.setOutputLayers(OutputLayers::Colour);
   }
   nlohmann::json warm = nlohmann::json::array(), warmTrace = nlohmann::json::array();
   nlohmann::json warmStages = nlohmann::json::array();  // where a warm frame's time goes
