@@ -305,10 +305,11 @@ const FrameOutput& FramePipeline::readOutput() {
   } else {
     device.downloadInto(s.shaded, image.rgba);
   }
-  if (mOutputLayers == OutputLayers::Colour) {
-    for (auto* layer : {&image.depth, &image.unsmoothedDepth, &image.thickness, &image.attribute}) layer->clear();
-    image.normal.clear();
-    image.foam.clear();
+  if (mOutputLayers == OutputLayers::Colour) {  // the layers' storage freed, not kept
+    for (auto* layer : {&image.depth, &image.unsmoothedDepth, &image.thickness, &image.attribute})
+      std::vector<float>().swap(*layer);
+    std::vector<glm::vec3>().swap(image.normal);
+    std::vector<glm::vec4>().swap(image.foam);
     image.attributeName.clear();
     return out;
   }

@@ -28,6 +28,8 @@ class CpuScreenDevice : public ScreenDevice {
                std::initializer_list<ScreenImage> inputs, ScreenImage output, ScreenImage secondOutput) override;
 
   /// The image's elements in place (no copy), for callers on the CPU; not of an adopted image.
+  /// Writable: an image whose storage went to exchangePixels() comes back zeroed (read() checks
+  /// that it was written again instead).
   std::span<glm::vec4> pixels(ScreenImage image);
   /// Moves the frame image's pixels into `pixels` (no copy) and takes the vector's storage in
   /// their place: its contents are undefined until a pass writes the image. Storage of another

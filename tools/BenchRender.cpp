@@ -255,6 +255,7 @@ void runBenchRender(const BenchRenderArgs& a) {
     BrickStore store = BrickStore::open(storeDir);
     settings.radius = defaultSphereRadius(store.header(), settings.jitter);
     FramePipeline pipeline(std::move(store), choice, settings, SurfaceSettings{});
+    pipeline.setOutputLayers(OutputLayers::Colour);  // a PNG's, as `render` reads it back
     deviceName = pipeline.deviceName();
     const Camera camera = frameOnBox(pipeline.renderer().occupiedBounds(0), double(width) / height, {0, 1, 0});
     const FrameOutput& cold = pipeline.render(0, camera);
