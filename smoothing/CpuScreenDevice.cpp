@@ -18,21 +18,19 @@ void CpuScreenDevice::setFrame(const ScreenFrame& frame) {
   mFrame = frame;
   if (!resized) return;
   for (Image& image : mImages)
-    if (image.perPixel && !image.adopted)
-      image.data.assign(std::size_t(frame.width) * frame.height * image.perPixel, glm::vec4(0));
+    if (image.perPixel && !image.adopted) image.data.assign(frameElements(image.perPixel), glm::vec4(0));
 }
 
 ScreenImage CpuScreenDevice::createFrameImage(std::uint32_t perPixel) {
   FLIPSCOPE_CHECK(perPixel > 0);
-  mImages.push_back({perPixel, std::vector<glm::vec4>(std::size_t(width()) * height() * perPixel, glm::vec4(0))});
+  mImages.push_back({perPixel, std::vector<glm::vec4>(frameElements(perPixel), glm::vec4(0))});
   return ScreenImage(mImages.size() - 1);
 }
 
 std::vector<ScreenImage> CpuScreenDevice::createFrameImages(std::size_t count) {
   // The zeroing is most of the cost (the kernel's first touch of the pages): on every core.
   std::vector<std::vector<glm::vec4>> pixels(count);
-  tbb::parallel_for(std::size_t(0), count,
-                    [&](std::size_t i) { pixels[i].assign(std::size_t(width()) * height(), glm::vec4(0)); });
+  tbb::parallel_for(std::size_t(0), count, [&](std::size_t i) { pixels[i].assign(frameElements(1), glm::vec4(0)); });
   std::vector<ScreenImage> images;
   for (auto& data : pixels) {
     mImages.push_back({1, std::move(data)});
@@ -62,16 +60,15 @@ CpuScreenDevice::Image& CpuScreenDevice::target(ScreenImage handle) {
   Image& target = image(handle);
   FLIPSCOPE_CHECK(!target.adopted, "screen image " << handle << " is adopted: an input only");
   // A frame image whose storage went to exchangePixels() gets its pixels back here.
-  const std::size_t elements = std::size_t(width()) * height() * target.perPixel;
-  if (target.perPixel && target.data.size() != elements) target.data.assign(elements, glm::vec4(0));
+  if (target.perPixel && target.data.size() != frameElements(target.perPixel))
+    target.data.assign(frameElements(target.perPixel), glm::vec4(0));
   return target;
 }
 
 std::span<const glm::vec4> CpuScreenDevice::read(ScreenImage handle) {
   const Image& source = image(handle);
-  FLIPSCOPE_CHECK(
-      source.adopted || !source.perPixel || source.data.size() == std::size_t(width()) * height() * source.perPixel,
-      "screen image " << handle << " read after exchangePixels() before a pass wrote it");
+  FLIPSCOPE_CHECK(source.adopted || !source.perPixel || source.data.size() == frameElements(source.perPixel),
+                  "screen image " << handle << " read after exchangePixels() before a pass wrote it");
   return source.adopted ? source.adopted() : std::span<const glm::vec4>(source.data);
 }
 

@@ -47,6 +47,8 @@ class CpuScreenDevice : public ScreenDevice {
     std::function<std::span<const glm::vec4>()> adopted;  ///< set: the pixels are elsewhere
   };
   Image& image(ScreenImage handle);
+  /// The vec4 of a frame image of `perPixel` vec4 a pixel, at the current frame's size.
+  std::size_t frameElements(std::uint32_t perPixel) const { return std::size_t(width()) * height() * perPixel; }
   /// An image that is written to (not adopted).
   Image& target(ScreenImage handle);
   std::span<const glm::vec4> read(ScreenImage handle);
