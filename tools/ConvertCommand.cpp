@@ -10,6 +10,7 @@
 #include "core/ProcessMemory.h"
 #include "preprocess/Convert.h"
 #include "preprocess/particles/InputSequence.h"
+#include "tools/CliChecks.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
 
@@ -109,11 +110,11 @@ void addConvertCommand(CLI::App& app) {
   cmd->add_option("--frames", args->frames, "Frame range A-B for patterns (default: every frame found)");
   cmd->add_option("--grid", args->grids, "VDB: PointDataGrid names to read (default: all)");
   auto* cell = cmd->add_option("--cell-size", args->cellSize, "Cell size in world units (default: see --resolution)")
-                   ->check(CLI::PositiveNumber);
+                   ->check(positiveNumber());
   cmd->add_option("--resolution", args->resolution,
                   "Cells along the longest domain axis (default: one cell per particle spacing, measured on the "
                   "first frame; 1024 when it cannot be)")
-      ->check(CLI::PositiveNumber)
+      ->check(positiveCount())
       ->excludes(cell);
   cmd->add_option("--brick-size", args->brickSize, "Cells per brick edge")
       ->check(CLI::IsMember({32, 64, 128}))
@@ -121,7 +122,7 @@ void addConvertCommand(CLI::App& app) {
   cmd->add_option("--particle-spacing", args->particleSpacing,
                   "Particle spacing in world units, e.g. the simulation's particle separation (default: measured "
                   "on the first frame; with --domain too, convert reads each frame once; 0: unknown, not measured)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(nonNegativeNumber());
   cmd->add_option("--domain", args->domain, "x0,y0,z0,x1,y1,z1 in world units (default: bounds of the data)");
   cmd->add_option("--mem", args->mem, "Memory budget, e.g. 512M, 8G")->capture_default_str();
   cmd->add_option("--attribute", args->attribute,

@@ -17,6 +17,7 @@
 #include "preprocess/store/StoreInspection.h"
 #include "raycast/Camera.h"
 #include "streaming/BrickSource.h"
+#include "tools/CliChecks.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
 #include "tools/FarmCommon.h"
@@ -44,10 +45,10 @@ struct FarmArgs {
 void addFarmOptions(CLI::App* cmd, FarmArgs& a) {
   cmd->add_option("--frames", a.frames, "Frame range A-B (default: every frame)");
   cmd->add_option("--chunk", a.chunk, "Frames per array task (default 1; on --resume, the plan's)")
-      ->check(CLI::PositiveNumber);
+      ->check(positiveCount());
   cmd->add_option("--partition", a.resources.partition, "Scheduler partition (queue) of every task");
   cmd->add_option("--time", a.resources.time, "Wall-time limit of every task, e.g. 2:00:00");
-  cmd->add_option("--cpus", a.resources.cpus, "CPUs of every task")->check(CLI::PositiveNumber);
+  cmd->add_option("--cpus", a.resources.cpus, "CPUs of every task")->check(positiveCount());
   cmd->add_option("--mem", a.resources.memory, "Memory of every task, e.g. 16G");
   cmd->add_option("--flipscope", a.flipscope,
                   "The flipscope binary the tasks run, on a path every node sees (default: this one)");
@@ -365,13 +366,13 @@ void addFarmCommand(CLI::App& app) {
   c->add_flag("--resume", convert->farm.resume, "Submit only the frames the store lacks (after a failed task)");
   c->add_option("--domain", convert->domain, "x0,y0,z0,x1,y1,z1 (default: a bounds pass over the frames, in parallel)");
   auto* cell = c->add_option("--cell-size", convert->cellSize, "Cell size in world units (default: as convert)")
-                   ->check(CLI::PositiveNumber);
+                   ->check(positiveNumber());
   c->add_option("--resolution", convert->resolution, "Cells along the longest domain axis")
-      ->check(CLI::PositiveNumber)
+      ->check(positiveCount())
       ->excludes(cell);
   c->add_option("--particle-spacing", convert->particleSpacing,
                 "Particle spacing in world units (default: measured, as convert; 0: unknown)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(nonNegativeNumber());
   c->add_option("--brick-size", convert->brickSize, "Cells per brick edge")->check(CLI::IsMember({32, 64, 128}));
   c->add_option("--attribute", convert->attribute, "Per-particle attribute to store, as for convert");
   c->add_option("--kind-attribute", convert->kindAttribute, "Particle type attribute (auto, none or a name), as for convert");

@@ -17,6 +17,7 @@
 #include "preprocess/SynthFluid.h"
 #include "preprocess/particles/InputSequence.h"
 #include "preprocess/particles/ParticleWriter.h"
+#include "tools/CliChecks.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
 
@@ -126,7 +127,7 @@ void addSynthCommand(CLI::App& app) {
   cmd->add_option("--frames", args->frames, "frame range A-B, or one frame A")->capture_default_str();
   cmd->add_option("--seed", args->seed, "seed of the wave phases, jitter and spray")->capture_default_str();
   cmd->add_option("--size", args->size, "horizontal extent of the box in metres, about")
-      ->check(CLI::PositiveNumber)
+      ->check(positiveNumber())
       ->capture_default_str();
   cmd->add_flag("--velocity", args->velocity,
                 "write velocities (PLY vx vy vz, VDB and Houdini v, PRT Velocity, VTK velocity; raw has none)");

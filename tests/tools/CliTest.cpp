@@ -2,9 +2,11 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "TestSupport.h"
 
@@ -235,6 +237,25 @@ TEST_F(Cli, BadInputsGiveClearErrorsAndExitCodes) {
   CommandRun badMem = runFlipscope("convert " + path("odd.bin") + " -o " + path("s3") + " --mem lots");
   EXPECT_EQ(badMem.exitCode, 2) << badMem.output;
   EXPECT_NE(badMem.output.find("--mem"), std::string::npos) << badMem.output;
+
+  // Numbers out of range are named plainly, without CLI11's range up to the largest double.
+  for (const auto& [option, value, expected] :
+       std::vector<std::array<std::string, 3>>{{"--cell-size", "abc", "a number above 0"},
+                                               {"--cell-size", "0", "a number above 0"},
+                                               {"--cell-size", "1e400", "a number above 0"},
+                                               {"--resolution", "-3", "a whole number above 0"},
+                                               {"--resolution", "2.5", "a whole number above 0"},
+                                               {"--particle-spacing", "-1", "a number of 0 or more"},
+                                               {"--particle-spacing", "inf", "a number of 0 or more"},
+                                               {"--particle-spacing", "nan", "a number of 0 or more"},
+                                               {"--particle-spacing", "1.5x", "a number of 0 or more"}}) {
+    CommandRun bad = runFlipscope("convert " + path("odd.bin") + " -o " + path("s4") + " " + option + " " + value);
+    EXPECT_EQ(bad.exitCode, 2) << bad.output;
+    EXPECT_NE(bad.output.find(option + ": expected " + expected + ", got '" + value + "'"), std::string::npos)
+        << bad.output;
+    EXPECT_EQ(bad.output.find("1797"), std::string::npos) << bad.output;
+    EXPECT_FALSE(fs::exists(dir / "s4"));
+  }
 
   CommandRun notStore = runFlipscope("info " + path(""));
   EXPECT_EQ(notStore.exitCode, 3) << notStore.output;
