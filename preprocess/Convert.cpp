@@ -8,9 +8,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
-#include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <future>
@@ -23,6 +21,7 @@
 #include "core/AtomicFile.h"
 #include "core/Elapsed.h"
 #include "core/Error.h"
+#include "core/NumberText.h"
 #include "preprocess/BrickBinning.h"
 #include "preprocess/DirectFile.h"
 #include "preprocess/FiniteBounds.h"
@@ -527,18 +526,6 @@ Box scanBounds(ParticleSource& source, std::size_t chunkParticles, bool readAhea
   return bounds;
 }
 
-std::string formatNumber(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", v);
-  return text;
-}
-
-/// The shortest decimal that reads back as `v` exactly.
-std::string formatExact(double v) {
-  char text[32];
-  return std::string(text, std::to_chars(text, text + sizeof text, v).ptr);
-}
-
 /// What a pass over the positions alone reads: no velocities, no attributes.
 ReadOptions positionsOnly(ReadOptions read) {
   read.velocity = false;
@@ -655,8 +642,8 @@ StoreHeader chooseHeader(const Box& bounds, const ConvertOptions& options, const
       report.cellSizeOrigin = "one cell per particle spacing";
       return makeStoreHeader(bounds, o, attribute.kind, attribute.name);
     }
-    report.warnings.push_back("one cell per particle spacing (" + formatNumber(spacing.spacing) +
-                              ") would make the domain " + formatNumber(cells) + " cells long, more than " +
+    report.warnings.push_back("one cell per particle spacing (" + numberText(spacing.spacing) +
+                              ") would make the domain " + numberText(cells) + " cells long, more than " +
                               std::to_string(kMaxCellsPerAxis) + fallback);
   } else {
     report.warnings.push_back("the particle spacing is unknown (" + spacing.origin + ")" + fallback);
@@ -1053,14 +1040,14 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
                          " (store version " + std::to_string(header.version) + "), not " +
                          std::string(upAxisName(*options.upAxis)) + " (--up); convert into a new store to change it");
       if (options.cellSize && *options.cellSize != header.cellSize)
-        throw InputError(storeDir.string() + ": the store's cells are " + formatExact(header.cellSize) +
-                         " world units, not " + formatExact(*options.cellSize) +
+        throw InputError(storeDir.string() + ": the store's cells are " + exactNumberText(header.cellSize) +
+                         " world units, not " + exactNumberText(*options.cellSize) +
                          " (--cell-size); convert into a new store to change them");
       if (options.particleSpacing && *options.particleSpacing != header.particleSpacing)
         throw InputError(storeDir.string() + ": the store's particle spacing is " +
-                         (header.particleSpacing > 0 ? formatExact(header.particleSpacing) + " world units"
+                         (header.particleSpacing > 0 ? exactNumberText(header.particleSpacing) + " world units"
                                                      : std::string("unknown (0)")) +
-                         ", not " + formatExact(*options.particleSpacing) +
+                         ", not " + exactNumberText(*options.particleSpacing) +
                          " (--particle-spacing); convert into a new store to change it");
       report.cellSizeOrigin = "kept from the existing store";
       report.spacingOrigin = "the existing store";

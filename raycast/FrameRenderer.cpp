@@ -12,6 +12,7 @@
 
 #include "core/Elapsed.h"
 #include "core/Error.h"
+#include "core/NumberText.h"
 #include "streaming/BrickMipmap.h"
 
 namespace flipscope {
@@ -50,12 +51,12 @@ void validate(const RenderSettings& s) {
     throw InputError("--size: width and height must be in 1..16384, got " + std::to_string(s.width) + "x" +
                      std::to_string(s.height));
   if (!(s.radius > 0.0f) || !std::isfinite(s.radius))
-    throw InputError("--radius: must be a positive number of cells, got " + std::to_string(s.radius));
+    throw InputError("--radius: must be a positive number of cells, got " + numberText(s.radius));
   if (!(s.jitter >= 0.0f) || !std::isfinite(s.jitter))
-    throw InputError("--jitter: must be 0 or a positive number of cells, got " + std::to_string(s.jitter));
+    throw InputError("--jitter: must be 0 or a positive number of cells, got " + numberText(s.jitter));
   if (sphereReach(s.radius, s.jitter) > kMaxOverlap)
-    throw InputError("--radius plus jitter reach " + std::to_string(sphereReach(s.radius, s.jitter)) +
-                     " cells; at most " + std::to_string(kMaxOverlap) + " fit the bit-brick border");
+    throw InputError("--radius plus jitter reach " + numberText(sphereReach(s.radius, s.jitter)) + " cells; at most " +
+                     std::to_string(kMaxOverlap) + " fit the bit-brick border");
   if (s.maxPasses < 1) throw InputError("--max-passes: must be at least 1");
   validate(s.foam);
   if (!(s.thicknessSaturationCells >= 0.0f) || !std::isfinite(s.thicknessSaturationCells))

@@ -4,9 +4,9 @@
 
 #include <cmath>
 #include <functional>
-#include <sstream>
 
 #include "core/Error.h"
+#include "core/NumberText.h"
 #include "smoothing/detail/Filters.h"
 
 namespace flipscope {
@@ -49,11 +49,6 @@ const Entry* find(const std::string& name) {
   return nullptr;
 }
 
-std::string formatNumber(float value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
 }  // namespace
 
 const std::vector<SurfaceFilterInfo>& surfaceFilters() {
@@ -85,9 +80,9 @@ SmoothingOptions resolve(const SmoothingOptions& options) {
                                               : "0.." + std::to_string(info.maxIterations)));
   if (out.strength == -1.0f) out.strength = info.defaultStrength;
   if (!std::isfinite(out.strength) || out.strength < info.minStrength || out.strength > info.maxStrength)
-    throw InputError("--smoothing-strength: " + formatNumber(out.strength) + " is out of range for " +
+    throw InputError("--smoothing-strength: " + numberText(out.strength) + " is out of range for " +
                      std::string(info.name) + " (" + std::string(info.strengthMeaning) +
-                     "); valid values: " + formatNumber(info.minStrength) + ".." + formatNumber(info.maxStrength));
+                     "); valid values: " + numberText(info.minStrength) + ".." + numberText(info.maxStrength));
   return out;
 }
 

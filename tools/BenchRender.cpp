@@ -15,6 +15,7 @@
 
 #include "core/Elapsed.h"
 #include "core/Error.h"
+#include "core/NumberText.h"
 #include "pipeline/FramePipeline.h"
 #include "preprocess/Convert.h"
 #include "preprocess/SynthFluid.h"
@@ -175,8 +176,7 @@ PeerComparison compareWithEmbree(const fs::path& work, const fs::path& particles
   const fs::path store = work / "peer.store", cameraFile = work / "peer_camera.json";
   saveCamera(cameraFile, camera);
   fs::remove_all(store);
-  char cell[32];
-  std::snprintf(cell, sizeof cell, "%.17g", cellSize);
+  const std::string cell = exactNumberText(cellSize);
   const ChildRun convert = runFlipscopeStage(
       "peer's convert", {"convert", particles.string(), "-o", store.string(), "--cell-size", cell}, work / "peer_convert.log");
   c.convertSeconds = convert.seconds;
@@ -193,8 +193,7 @@ PeerComparison compareWithEmbree(const fs::path& work, const fs::path& particles
   c.radiusWorld = float(defaultSphereRadius(header, RenderSettings{}.jitter) * header.cellSize);
   const fs::path givenStore = work / "peer_spacing_given.store";
   fs::remove_all(givenStore);
-  char spacing[32];
-  std::snprintf(spacing, sizeof spacing, "%.17g", header.particleSpacing);
+  const std::string spacing = exactNumberText(header.particleSpacing);
   const ChildRun given = runFlipscopeStage(
       "peer's convert, the spacing given",
       {"convert", particles.string(), "-o", givenStore.string(), "--cell-size", cell, "--particle-spacing", spacing},

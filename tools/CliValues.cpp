@@ -2,12 +2,12 @@
 
 #include <charconv>
 #include <cmath>
-#include <cstdio>
-#include <string_view>
 #include <sstream>
+#include <string_view>
 #include <vector>
 
 #include "core/Error.h"
+#include "core/NumberText.h"
 
 namespace flipscope::tools {
 namespace {
@@ -137,16 +137,10 @@ std::optional<UpAxis> parseUpAxis(const std::string& option, const std::string& 
   throw InputError(option + ": expected auto, x, y or z, got '" + text + "'");
 }
 
-std::string formatNumber17(double value) {
-  char text[40];
-  std::snprintf(text, sizeof text, "%.17g", value);
-  return text;
-}
-
 std::string formatBox(const Box& box) {
   std::string text;
   for (double v : {box.min.x, box.min.y, box.min.z, box.max.x, box.max.y, box.max.z})
-    text += (text.empty() ? "" : ",") + formatNumber17(v);
+    text += (text.empty() ? "" : ",") + exactNumberText(v);
   return text;
 }
 

@@ -26,10 +26,8 @@ std::pair<std::uint32_t, std::uint32_t> parseImageSize(const std::string& option
 DeviceChoice parseDeviceChoice(const std::string& option, const std::string& text);
 /// `--up`: "x", "y" or "z"; "auto" (nullopt): what the store or the input files say.
 std::optional<UpAxis> parseUpAxis(const std::string& option, const std::string& text);
-/// A box as parseBox reads it, every number with 17 significant digits (read back exactly).
+/// A box as parseBox reads it, every number read back exactly (exactNumberText).
 std::string formatBox(const Box& box);
-/// A number with 17 significant digits (read back exactly).
-std::string formatNumber17(double value);
 /// "none", "speed (the length of the velocity)", "pscale (scalar)", "v (the length of a vector)".
 std::string describeAttribute(const StoreHeader& header);
 /// The cells of each particle kind: "liquid 120, foam 3, spray 40, bubble 0".

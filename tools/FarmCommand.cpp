@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "core/Error.h"
+#include "core/NumberText.h"
 #include "preprocess/Convert.h"
 #include "preprocess/particles/InputSequence.h"
 #include "preprocess/store/StoreInspection.h"
@@ -233,9 +234,9 @@ void runFarmConvert(const ConvertFarmArgs& a) {
     auto prepareOnly = [&](const std::string& option, const std::string& value) {
       plan.prepareArgs.insert(plan.prepareArgs.end(), {option, value});
     };
-    if (a.cellSize > 0) prepareOnly("--cell-size", formatNumber17(a.cellSize));
+    if (a.cellSize > 0) prepareOnly("--cell-size", exactNumberText(a.cellSize));
     if (a.resolution > 0) prepareOnly("--resolution", std::to_string(a.resolution));
-    if (a.particleSpacing) prepareOnly("--particle-spacing", formatNumber17(*a.particleSpacing));
+    if (a.particleSpacing) prepareOnly("--particle-spacing", exactNumberText(*a.particleSpacing));
     if (a.brickSize > 0) prepareOnly("--brick-size", std::to_string(a.brickSize));
     if (!a.attribute.empty()) prepareOnly("--attribute", a.attribute);
     plan.convertArgs.insert(plan.convertArgs.end(), {"--zstd-level", std::to_string(a.zstdLevel)});

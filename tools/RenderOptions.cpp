@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "core/Error.h"
+#include "core/NumberText.h"
 #include "smoothing/SurfaceFilter.h"
 #include "smoothing/SurfaceShading.h"
 #include "tools/CliValues.h"
@@ -68,7 +69,7 @@ ParsedLook parseRenderLook(const RenderLookArgs& a) {
   if (a.smoothingIterations && *a.smoothingIterations < 0)
     throw InputError("--smoothing-iterations: must be 0 or more, got " + std::to_string(*a.smoothingIterations));
   if (a.smoothingStrength && !(*a.smoothingStrength >= 0))
-    throw InputError("--smoothing-strength: must be 0 or more, got " + std::to_string(*a.smoothingStrength));
+    throw InputError("--smoothing-strength: must be 0 or more, got " + numberText(*a.smoothingStrength));
   job.surface.smoothing = resolve(job.surface.smoothing);
   job.surface.shading.mode = parseShadingMode(a.shading);
   if (a.colorMap) job.surface.shading.colorMap = parseColorMap(*a.colorMap);

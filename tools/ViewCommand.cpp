@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "core/Error.h"
+#include "core/NumberText.h"
 #include "core/ProcessMemory.h"
 #include "gl/EglContext.h"
 #include "tools/CliValues.h"
@@ -44,7 +45,7 @@ void runView(const ViewArgs& a) {
   o.camera = look.camera;
   o.device = look.device;
   o.frame = a.frame;
-  if (a.scale < 0 || a.scale > 2) throw InputError("--scale: must be in (0, 2], got " + std::to_string(a.scale));
+  if (a.scale < 0 || a.scale > 2) throw InputError("--scale: must be in (0, 2], got " + numberText(a.scale));
   o.resolutionScale = a.scale;
   if (!(a.budgetMs > 0)) throw InputError("--budget-ms: must be positive");
   o.budgetMs = a.budgetMs;
