@@ -34,6 +34,10 @@ int main(int argc, char** argv) {
   CLI::App app{"flipscope: preview giga-particle fluid simulation caches (Reichl et al. 2014)", "flipscope"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "flipscope 0.1.0");
+  // A usage error reads as every other error does ("flipscope: error: ..."), exit 2.
+  app.failure_message([](const CLI::App*, const CLI::Error& e) {
+    return std::string("flipscope: error: ") + e.what() + "\nRun with --help for more information.\n";
+  });
   tools::addConvertCommand(app);
   tools::addInfoCommand(app);
   tools::addInspectCommand(app);

@@ -238,7 +238,8 @@ TEST_F(Cli, BadInputsGiveClearErrorsAndExitCodes) {
   EXPECT_EQ(badMem.exitCode, 2) << badMem.output;
   EXPECT_NE(badMem.output.find("--mem"), std::string::npos) << badMem.output;
 
-  // Numbers out of range are named plainly, without CLI11's range up to the largest double.
+  // Numbers out of range are named plainly, without CLI11's range up to the largest double, and
+  // a usage error reads as every other error.
   for (const auto& [option, value, expected] :
        std::vector<std::array<std::string, 3>>{{"--cell-size", "abc", "a number above 0"},
                                                {"--cell-size", "0", "a number above 0"},
@@ -251,7 +252,8 @@ TEST_F(Cli, BadInputsGiveClearErrorsAndExitCodes) {
                                                {"--particle-spacing", "1.5x", "a number of 0 or more"}}) {
     CommandRun bad = runFlipscope("convert " + path("odd.bin") + " -o " + path("s4") + " " + option + " " + value);
     EXPECT_EQ(bad.exitCode, 2) << bad.output;
-    EXPECT_NE(bad.output.find(option + ": expected " + expected + ", got '" + value + "'"), std::string::npos)
+    EXPECT_NE(bad.output.find("flipscope: error: " + option + ": expected " + expected + ", got '" + value + "'"),
+              std::string::npos)
         << bad.output;
     EXPECT_EQ(bad.output.find("1797"), std::string::npos) << bad.output;
     EXPECT_FALSE(fs::exists(dir / "s4"));
