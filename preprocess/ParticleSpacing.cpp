@@ -14,7 +14,6 @@
 #include <numbers>
 #include <optional>
 #include <random>
-#include <sstream>
 #include <vector>
 
 #include <tbb/blocked_range.h>
@@ -24,6 +23,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/Error.h"
+#include "core/NumberText.h"
 #include "preprocess/FiniteBounds.h"
 
 namespace flipscope {
@@ -41,12 +41,6 @@ constexpr double kMaxAxisCells = 4096;
 double ballFactor() { return std::cbrt(4 * std::numbers::pi / (3 * double(kSpacingNeighbour))); }
 
 bool isFinite(const glm::vec3& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); }
-
-std::string text(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
 
 /// The query particles: a uniform random sample of the source's finite particles.
 struct Sample {
@@ -623,7 +617,8 @@ SpacingEstimate neighbourSpacing(ParticleSource& source, std::size_t sampleSize,
     return e;
   }
   e.spacing = median * ballFactor();
-  e.origin = "median " + std::to_string(kSpacingNeighbour) + "th-neighbour distance " + text(median) + " of " + of;
+  e.origin =
+      "median " + std::to_string(kSpacingNeighbour) + "th-neighbour distance " + numberText(median) + " of " + of;
   return e;
 }
 

@@ -13,6 +13,7 @@
 
 #include "core/AtomicFile.h"
 #include "core/Error.h"
+#include "core/NumberText.h"
 
 namespace flipscope {
 
@@ -36,7 +37,7 @@ void validate(const Camera& camera, const std::string& what) {
   if (glm::length(glm::cross(glm::normalize(view), camera.up)) < 1e-6)
     throw InputError(what + ": camera up vector is zero or parallel to the view direction");
   if (!(camera.fovYDegrees > 0 && camera.fovYDegrees < 180))
-    throw InputError(what + ": field of view must be in (0, 180) degrees, got " + std::to_string(camera.fovYDegrees));
+    throw InputError(what + ": field of view must be in (0, 180) degrees, got " + numberText(camera.fovYDegrees));
 }
 
 Camera orbitAbout(const Camera& camera, glm::dvec3 axis, double degrees) {

@@ -43,11 +43,11 @@ void validate(const FoamSettings& s) {
   if (!(s.threshold >= 0.0f && s.threshold <= 1.0f))
     throw InputError("--foam-threshold: must be a fraction in 0..1, got " + numberText(s.threshold));
   if (!(s.extinction >= 0.0f) || !std::isfinite(s.extinction))
-    throw InputError("foam extinction must be 0 or positive, got " + std::to_string(s.extinction));
+    throw InputError("foam extinction must be 0 or positive, got " + numberText(s.extinction));
   if (!(s.step > 0.0f) || !std::isfinite(s.step))
     throw InputError("foam step must be a positive number of cells, got " + numberText(s.step));
   if (!(s.opacityStop > 0.0f && s.opacityStop <= 1.0f))
-    throw InputError("foam opacity stop must be in (0, 1], got " + std::to_string(s.opacityStop));
+    throw InputError("foam opacity stop must be in (0, 1], got " + numberText(s.opacityStop));
 }
 
 }  // namespace flipscope

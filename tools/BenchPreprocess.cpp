@@ -21,6 +21,7 @@
 
 #include "core/Elapsed.h"
 #include "core/Error.h"
+#include "core/NumberText.h"
 #include "core/ProcessMemory.h"
 #include "preprocess/Convert.h"
 #include "preprocess/SynthFluid.h"
@@ -113,7 +114,7 @@ void runBenchPreprocess(const BenchPreprocessArgs& a) {
     }
     files.push_back(raw);
     source = "synth raw float32, " + std::to_string(fluid.count()) + " particles, cell size " +
-             std::to_string(fluid.cellSize()) + " (8 per cell in the body)";
+             numberText(fluid.cellSize()) + " (8 per cell in the body)";
   }
 
   // Pass 1 warms the page cache; pass 2 is the measured raw-read limit.

@@ -1,6 +1,7 @@
 #include "tools/CliChecks.h"
 
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -21,6 +22,7 @@ std::optional<double> finiteNumber(const std::string& text) {
   return value;
 }
 
+/// positiveNumber() (zeroAllowed false) or nonNegativeNumber() (true).
 CLI::Validator numberCheck(bool zeroAllowed) {
   const std::string expected = zeroAllowed ? "a number of 0 or more" : "a number above 0";
   return CLI::Validator(
@@ -39,11 +41,18 @@ CLI::Validator positiveNumber() { return numberCheck(false); }
 CLI::Validator positiveCount() {
   return CLI::Validator(
       [](std::string& text) -> std::string {
-        const auto value = finiteNumber(text);
-        if (value && *value >= 1 && *value <= std::numeric_limits<std::int32_t>::max() && *value == std::floor(*value) &&
-            text.find_first_not_of("+0123456789") == std::string::npos)
-          return {};
-        return "expected a whole number above 0, got '" + text + "'";
+        // Decimal digits, an optional '+' first. The text is rewritten without it and without
+        // leading zeros: CLI11 reads integers in base 0, where "010" would be 8.
+        const char* first = text.data() + (text.starts_with('+') ? 1 : 0);
+        const char* last = text.data() + text.size();
+        std::int64_t value = 0;
+        const auto [end, error] = std::from_chars(first, last, value);
+        if (first == last || error != std::errc() || end != last || value < 1 ||
+            value > std::numeric_limits<std::int32_t>::max())
+          return "expected a whole number from 1 to " + std::to_string(std::numeric_limits<std::int32_t>::max()) +
+                 ", got '" + text + "'";
+        text = std::to_string(value);
+        return {};
       },
       "POSITIVE");
 }

@@ -147,9 +147,7 @@ nlohmann::json inspectFile(const std::filesystem::path& path, bool headerOnly) {
 std::string numbers(const nlohmann::json& values) {
   std::string text;
   for (const auto& v : values) {
-    char buffer[32];
-    std::snprintf(buffer, sizeof buffer, "%.6g", v.get<double>());
-    text += (text.empty() ? "" : ", ") + std::string(buffer);
+    text += (text.empty() ? "" : ", ") + numberText(v.get<double>());
   }
   return values.size() == 1 ? text : "(" + text + ")";
 }

@@ -8,6 +8,7 @@
 #include "core/NumberText.h"
 #include "core/ProcessMemory.h"
 #include "gl/EglContext.h"
+#include "tools/CliChecks.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
 #include "tools/RenderOptions.h"
@@ -39,7 +40,7 @@ void runView(const ViewArgs& a) {
   o.inputs = a.inputs;
   o.cacheDir = a.cache;
   if (a.resolution) o.convertArgs.insert(o.convertArgs.end(), {"--resolution", std::to_string(*a.resolution)});
-  if (a.cellSize) o.convertArgs.insert(o.convertArgs.end(), {"--cell-size", std::to_string(*a.cellSize)});
+  if (a.cellSize) o.convertArgs.insert(o.convertArgs.end(), {"--cell-size", exactNumberText(*a.cellSize)});
   ParsedLook look = parseRenderLook(a.look);
   o.request = look.request;
   o.camera = look.camera;
@@ -80,8 +81,11 @@ void addViewCommand(CLI::App& app) {
                   "A brick store directory, or particle files / sequence patterns (converted into a cache store)")
       ->required();
   cmd->add_option("--cache", args->cache, "Directory of the cache store of particle inputs (default: beside them)");
-  cmd->add_option("--resolution", args->resolution, "Converting particle inputs: cells along the longest axis");
-  cmd->add_option("--cell-size", args->cellSize, "Converting particle inputs: cell size in world units");
+  auto* cell = cmd->add_option("--cell-size", args->cellSize, "Converting particle inputs: cell size in world units")
+                   ->check(positiveNumber());
+  cmd->add_option("--resolution", args->resolution, "Converting particle inputs: cells along the longest axis")
+      ->transform(positiveCount())
+      ->excludes(cell);
   cmd->add_option("--frame", args->frame, "The frame shown first (default: the first)");
   cmd->add_option("--scale", args->scale,
                   "Render size / window size (default: 1 on a GPU, 0.5 on the CPU pipeline; 1 with --screenshot)");

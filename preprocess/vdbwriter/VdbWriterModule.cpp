@@ -55,7 +55,9 @@ bool write(const Points& in, std::ostream& out, char* error, std::size_t errorBy
     positions.getPos(i, p);
     if (std::abs(p.x()) / voxelSize > kMaxVoxelCoordinate || std::abs(p.y()) / voxelSize > kMaxVoxelCoordinate ||
         std::abs(p.z()) / voxelSize > kMaxVoxelCoordinate) {
-      fail("position " + p.str() + " is too far from the origin for voxel size " + std::to_string(voxelSize), error,
+      char voxelSizeText[32];  // as core/NumberText's numberText: this module links OpenVDB alone
+      std::snprintf(voxelSizeText, sizeof voxelSizeText, "%g", voxelSize);
+      fail("position " + p.str() + " is too far from the origin for voxel size " + std::string(voxelSizeText), error,
            errorBytes);
       return false;
     }

@@ -104,6 +104,17 @@ TEST_F(FarmCommand, DryRunPrintsEveryScriptAndWritesNothing) {
        at = spacing.output.find("--particle-spacing", at + 1))
     ++given;
   EXPECT_EQ(given, 1u) << "the prepare job's only: " << spacing.output;
+  // Counts are whole decimal numbers: "09" is 9 frames a task (one task for the 8 frames).
+  const CommandRun nine = runFlipscope("farm convert " + scenario.path("in/in_####.bin") + " -o " + scenario.path("s") +
+                                       " --chunk 09 --dry-run");
+  ASSERT_EQ(nine.exitCode, 0) << nine.output;
+  EXPECT_NE(nine.output.find("#SBATCH --array=0-0"), std::string::npos) << nine.output;
+  const CommandRun fraction = runFlipscope("farm convert " + scenario.path("in/in_####.bin") + " -o " +
+                                           scenario.path("s") + " --chunk 2.5 --dry-run");
+  EXPECT_EQ(fraction.exitCode, 2) << fraction.output;
+  EXPECT_NE(fraction.output.find("flipscope: error: --chunk: expected a whole number from 1 to 2147483647, got '2.5'"),
+            std::string::npos)
+      << fraction.output;
 }
 
 TEST_F(FarmCommand, BadRequestsAreRefusedNamingWhatIsWrong) {

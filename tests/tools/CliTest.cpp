@@ -244,8 +244,10 @@ TEST_F(Cli, BadInputsGiveClearErrorsAndExitCodes) {
        std::vector<std::array<std::string, 3>>{{"--cell-size", "abc", "a number above 0"},
                                                {"--cell-size", "0", "a number above 0"},
                                                {"--cell-size", "1e400", "a number above 0"},
-                                               {"--resolution", "-3", "a whole number above 0"},
-                                               {"--resolution", "2.5", "a whole number above 0"},
+                                               {"--resolution", "-3", "a whole number from 1 to 2147483647"},
+                                               {"--resolution", "2.5", "a whole number from 1 to 2147483647"},
+                                               {"--resolution", "2147483648", "a whole number from 1 to 2147483647"},
+                                               {"--resolution", "0x10", "a whole number from 1 to 2147483647"},
                                                {"--particle-spacing", "-1", "a number of 0 or more"},
                                                {"--particle-spacing", "inf", "a number of 0 or more"},
                                                {"--particle-spacing", "nan", "a number of 0 or more"},
@@ -258,6 +260,21 @@ TEST_F(Cli, BadInputsGiveClearErrorsAndExitCodes) {
     EXPECT_EQ(bad.output.find("1797"), std::string::npos) << bad.output;
     EXPECT_FALSE(fs::exists(dir / "s4"));
   }
+
+  // Counts are decimal: "010" is 10 cells, as "10" (CLI11 alone would read it in octal, as 8).
+  ASSERT_EQ(runFlipscope("synth -o " + path("few.ply") + " --particles 1k").exitCode, 0);
+  auto cellSizeLine = [&](const std::string& resolution, const std::string& store) {
+    const CommandRun run =
+        runFlipscope("convert " + path("few.ply") + " -o " + path(store) + " --resolution " + resolution);
+    EXPECT_EQ(run.exitCode, 0) << run.output;
+    const auto at = run.output.find("cell size");
+    return at == std::string::npos ? std::string() : run.output.substr(at, run.output.find(' ', at + 10) - at);
+  };
+  const std::string ten = cellSizeLine("10", "r10");
+  EXPECT_FALSE(ten.empty());
+  EXPECT_EQ(cellSizeLine("010", "r010"), ten);
+  EXPECT_EQ(cellSizeLine("+10", "rplus10"), ten);
+  EXPECT_NE(cellSizeLine("8", "r8"), ten);
 
   CommandRun notStore = runFlipscope("info " + path(""));
   EXPECT_EQ(notStore.exitCode, 3) << notStore.output;
