@@ -60,8 +60,8 @@ CpuScreenDevice::Image& CpuScreenDevice::target(ScreenImage handle) {
   Image& target = image(handle);
   FLIPSCOPE_CHECK(!target.adopted, "screen image " << handle << " is adopted: an input only");
   // A frame image whose storage went to exchangePixels() gets its pixels back here.
-  if (target.perPixel && target.data.size() != frameElements(target.perPixel))
-    target.data.assign(frameElements(target.perPixel), glm::vec4(0));
+  const std::size_t elements = frameElements(target.perPixel);
+  if (target.perPixel && target.data.size() != elements) target.data.assign(elements, glm::vec4(0));
   return target;
 }
 

@@ -129,9 +129,9 @@ void addBenchFarmCommand(CLI::App& bench) {
               "projection to big caches and farms");
   cmd->add_option("--frames", args->frames, "Frames of the synth sequence")->capture_default_str();
   cmd->add_option("--particles", args->particles, "Particles a frame")->capture_default_str();
-  cmd->add_option("--chunk", args->chunk, "Frames per array task")->transform(positiveCount())->capture_default_str();
+  cmd->add_option("--chunk", args->chunk, "Frames per array task")->check(positiveCount())->capture_default_str();
   cmd->add_option("--empty-tasks", args->emptyTasks, "Empty tasks that measure the scheduler's overhead")
-      ->transform(positiveCount())
+      ->check(positiveCount())
       ->capture_default_str();
   cmd->add_option("--shared-read", args->sharedRead, "Read rate of the farm's shared filesystem, GB/s")
       ->capture_default_str();

@@ -41,8 +41,7 @@ CLI::Validator positiveNumber() { return numberCheck(false); }
 CLI::Validator positiveCount() {
   return CLI::Validator(
       [](std::string& text) -> std::string {
-        // Decimal digits, an optional '+' first. The text is rewritten without it and without
-        // leading zeros: CLI11 reads integers in base 0, where "010" would be 8.
+        // Decimal digits, an optional '+' first.
         const char* first = text.data() + (text.starts_with('+') ? 1 : 0);
         const char* last = text.data() + text.size();
         std::int64_t value = 0;
@@ -51,10 +50,29 @@ CLI::Validator positiveCount() {
             value > std::numeric_limits<std::int32_t>::max())
           return "expected a whole number from 1 to " + std::to_string(std::numeric_limits<std::int32_t>::max()) +
                  ", got '" + text + "'";
-        text = std::to_string(value);
         return {};
       },
       "POSITIVE");
+}
+
+void readIntegersInDecimal(CLI::App& app) {
+  // Drops the leading zeros of a signed decimal integer ("-010" -> "-10"); other text ("0",
+  // "0x10", "abc") is left to the option's own checks and conversion.
+  const CLI::Validator decimal(
+      [](std::string& text) -> std::string {
+        const std::size_t digits = text.starts_with('+') || text.starts_with('-') ? 1 : 0;
+        const std::size_t significant = text.find_first_not_of('0', digits);
+        if (significant > digits && significant != std::string::npos &&
+            text.find_first_not_of("0123456789", digits) == std::string::npos)
+          text.erase(digits, significant - digits);
+        return {};
+      },
+      "");
+  for (CLI::Option* option : app.get_options()) {
+    const std::string type = option->get_type_name();
+    if (type.starts_with("INT") || type.starts_with("UINT")) option->transform(decimal);
+  }
+  for (CLI::App* subcommand : app.get_subcommands([](CLI::App*) { return true; })) readIntegersInDecimal(*subcommand);
 }
 
 CLI::Validator nonNegativeNumber() { return numberCheck(true); }

@@ -9,9 +9,12 @@ namespace flipscope::tools {
 /// A finite number above 0 ("--cell-size: expected a number above 0, got 'abc'").
 CLI::Validator positiveNumber();
 /// A whole number from 1 to 2^31 - 1 in decimal, for counts ("--cpus: expected a whole number from 1
-/// to 2147483647, got '1.5'"); "+8" and "010" are read as 8 and 10. Give it to Option::transform:
-/// it rewrites the text, which Option::check would not keep (CLI11 would then read "010" as 8).
+/// to 2147483647, got '1.5'"); "+8" and "010" are 8 and 10 (with readIntegersInDecimal).
 CLI::Validator positiveCount();
+/// Makes every integer option of `app` and of its subcommands, at any depth, read "010" as 10:
+/// CLI11 reads integers in base 0, where a leading zero means octal ("--frame 010" was frame 8).
+/// Call once every option is added.
+void readIntegersInDecimal(CLI::App& app);
 /// A finite number of 0 or more ("--particle-spacing: expected a number of 0 or more, got '-1'").
 CLI::Validator nonNegativeNumber();
 

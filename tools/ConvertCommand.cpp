@@ -114,7 +114,7 @@ void addConvertCommand(CLI::App& app) {
   cmd->add_option("--resolution", args->resolution,
                   "Cells along the longest domain axis (default: one cell per particle spacing, measured on the "
                   "first frame; 1024 when it cannot be)")
-      ->transform(positiveCount())
+      ->check(positiveCount())
       ->excludes(cell);
   cmd->add_option("--brick-size", args->brickSize, "Cells per brick edge")
       ->check(CLI::IsMember({32, 64, 128}))

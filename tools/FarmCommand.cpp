@@ -46,10 +46,10 @@ struct FarmArgs {
 void addFarmOptions(CLI::App* cmd, FarmArgs& a) {
   cmd->add_option("--frames", a.frames, "Frame range A-B (default: every frame)");
   cmd->add_option("--chunk", a.chunk, "Frames per array task (default 1; on --resume, the plan's)")
-      ->transform(positiveCount());
+      ->check(positiveCount());
   cmd->add_option("--partition", a.resources.partition, "Scheduler partition (queue) of every task");
   cmd->add_option("--time", a.resources.time, "Wall-time limit of every task, e.g. 2:00:00");
-  cmd->add_option("--cpus", a.resources.cpus, "CPUs of every task")->transform(positiveCount());
+  cmd->add_option("--cpus", a.resources.cpus, "CPUs of every task")->check(positiveCount());
   cmd->add_option("--mem", a.resources.memory, "Memory of every task, e.g. 16G");
   cmd->add_option("--flipscope", a.flipscope,
                   "The flipscope binary the tasks run, on a path every node sees (default: this one)");
@@ -369,7 +369,7 @@ void addFarmCommand(CLI::App& app) {
   auto* cell = c->add_option("--cell-size", convert->cellSize, "Cell size in world units (default: as convert)")
                    ->check(positiveNumber());
   c->add_option("--resolution", convert->resolution, "Cells along the longest domain axis")
-      ->transform(positiveCount())
+      ->check(positiveCount())
       ->excludes(cell);
   c->add_option("--particle-spacing", convert->particleSpacing,
                 "Particle spacing in world units (default: measured, as convert; 0: unknown)")

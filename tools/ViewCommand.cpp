@@ -84,7 +84,7 @@ void addViewCommand(CLI::App& app) {
   auto* cell = cmd->add_option("--cell-size", args->cellSize, "Converting particle inputs: cell size in world units")
                    ->check(positiveNumber());
   cmd->add_option("--resolution", args->resolution, "Converting particle inputs: cells along the longest axis")
-      ->transform(positiveCount())
+      ->check(positiveCount())
       ->excludes(cell);
   cmd->add_option("--frame", args->frame, "The frame shown first (default: the first)");
   cmd->add_option("--scale", args->scale,

@@ -8,6 +8,7 @@
 #include "core/Error.h"
 #include "core/HugePageAdvice.h"
 #include "core/ProcessMemory.h"
+#include "tools/CliChecks.h"
 #include "tools/Commands.h"
 
 namespace {
@@ -48,6 +49,7 @@ int main(int argc, char** argv) {
   tools::addViewCommand(app);
   tools::addFarmCommand(app);
   tools::addDevicesCommand(app);
+  tools::readIntegersInDecimal(app);
   // Huge pages where they fill faster (core/HugePageAdvice.h), chosen once the command line has
   // parsed (not for --help, --version or a usage error) and before the command runs, for the
   // commands that allocate large buffers: not for those that read headers or submit jobs.

@@ -261,7 +261,7 @@ TEST_F(Cli, BadInputsGiveClearErrorsAndExitCodes) {
     EXPECT_FALSE(fs::exists(dir / "s4"));
   }
 
-  // Counts are decimal: "010" is 10 cells, as "10" (CLI11 alone would read it in octal, as 8).
+  // Counts are decimal: "010" is 10 cells, as "10" (CLI11 alone reads it in octal, as 8).
   ASSERT_EQ(runFlipscope("synth -o " + path("few.ply") + " --particles 1k").exitCode, 0);
   auto cellSizeLine = [&](const std::string& resolution, const std::string& store) {
     const CommandRun run =
@@ -275,6 +275,10 @@ TEST_F(Cli, BadInputsGiveClearErrorsAndExitCodes) {
   EXPECT_EQ(cellSizeLine("010", "r010"), ten);
   EXPECT_EQ(cellSizeLine("+10", "rplus10"), ten);
   EXPECT_NE(cellSizeLine("8", "r8"), ten);
+  // So is every integer option: render's --frame 010 asks for frame 10, not 8.
+  const CommandRun frame = runFlipscope("render " + path("r10") + " -o " + path("f.png") + " --frame 010");
+  EXPECT_EQ(frame.exitCode, 2) << frame.output;
+  EXPECT_NE(frame.output.find("has no frame 10 "), std::string::npos) << frame.output;
 
   CommandRun notStore = runFlipscope("info " + path(""));
   EXPECT_EQ(notStore.exitCode, 3) << notStore.output;
