@@ -189,7 +189,7 @@ AtomicFile::AtomicFile(std::filesystem::path destination) : mDestination(std::mo
     throw OutputError(mDestination, "cannot be written (its temporary " + mTemporary.filename().string() +
                                         " cannot be created: " + reason + ")");
   }
-  std::setvbuf(mFile, nullptr, _IOFBF, 1 << 20);
+  mBuffer.attach(mFile, kAtomicFileBufferBytes);
 }
 
 AtomicFile::~AtomicFile() {
@@ -202,7 +202,7 @@ AtomicFile::~AtomicFile() {
 
 void AtomicFile::write(const void* data, std::size_t bytes) {
   FLIPSCOPE_CHECK(mFile, "write after commit");
-  if (bytes && std::fwrite(data, 1, bytes, mFile) != bytes) throw OutputError(mTemporary, "write failed: " + errnoText());
+  if (bytes && std::fwrite(data, 1, bytes, mFile) != bytes) throw temporaryFailure("write");
   mOffset += bytes;
 }
 
@@ -212,13 +212,19 @@ void AtomicFile::writeAt(std::uint64_t offset, const void* data, std::size_t byt
   if (::fseeko(mFile, static_cast<off_t>(offset), SEEK_SET) != 0 ||
       (bytes && std::fwrite(data, 1, bytes, mFile) != bytes) ||
       ::fseeko(mFile, static_cast<off_t>(mOffset), SEEK_SET) != 0)
-    throw OutputError(mTemporary, "write at byte " + std::to_string(offset) + " failed: " + errnoText());
+    throw temporaryFailure("write at byte " + std::to_string(offset));
+}
+
+OutputError AtomicFile::temporaryFailure(const std::string& what) const {
+  const std::string reason = errnoText();  // before anything else can change errno
+  return OutputError(mDestination, "cannot be written: " + what + " of its temporary " +
+                                       mTemporary.filename().string() + " failed: " + reason);
 }
 
 void AtomicFile::commit() {
   FLIPSCOPE_CHECK(mFile, "commit twice");
-  if (std::fflush(mFile) != 0) throw OutputError(mTemporary, "flush failed: " + errnoText());
-  if (::fsync(::fileno(mFile)) != 0) throw OutputError(mTemporary, "fsync failed: " + errnoText());
+  if (std::fflush(mFile) != 0) throw temporaryFailure("flush");
+  if (::fsync(::fileno(mFile)) != 0) throw temporaryFailure("fsync");
   std::fclose(mFile);
   mFile = nullptr;
   if (std::rename(mTemporary.c_str(), mDestination.c_str()) != 0) {

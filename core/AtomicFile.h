@@ -17,10 +17,15 @@
 #include <filesystem>
 #include <optional>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
+#include "core/StdioBuffer.h"
+
 namespace flipscope {
+
+class OutputError;
 
 /// Registers a path to remove when the process is stopped by SIGINT, SIGTERM or SIGHUP, for as
 /// long as the object lives (or until release()). Destroying it does not remove the path.
@@ -81,6 +86,9 @@ std::optional<long> temporaryFileOwner(std::string_view fileName);
 /// an unrelated process counts as existing, so a stale file then stays until that one ends.
 bool processExists(long pid);
 
+/// The bytes an AtomicFile gathers before it writes them.
+inline constexpr std::size_t kAtomicFileBufferBytes = std::size_t(1) << 20;
+
 class AtomicFile {
  public:
   /// Creates `<dir>/.<name>.tmp-<pid>-<n>` beside `destination`. Throws FileError.
@@ -106,8 +114,13 @@ class AtomicFile {
   std::filesystem::path mDestination;
   std::filesystem::path mTemporary;
   CleanupOnSignal mCleanup;  ///< the temporary, until committed or removed
+  StdioBuffer mBuffer;       ///< mFile's
   std::FILE* mFile = nullptr;
   std::uint64_t mOffset = 0;
+
+  /// The error of a failed `what` ("write", "flush") on the temporary, with errno's reason:
+  /// it names the destination, the file the user asked for, and the temporary it was written to.
+  OutputError temporaryFailure(const std::string& what) const;
 };
 
 /// Writes `bytes` to `destination` atomically.

@@ -37,7 +37,7 @@ done
 "$flipscope" render "$work/wave" -o "$out/synth20m-unsmoothed.png" --size 640x360 --smoothing none -q
 echo "docs/make-images.sh: wrote $(ls "$out" | wc -l) pictures to $out"
 
-# The viewer's window (docs/images/viewer-window.png): `flipscope view` on Mantaflow frame 20 under
+# The viewer's window (docs/images/viewer-window.png): `flipscope view` on Mantaflow frame 30 under
 # a private Xvfb, captured with xwd and cropped by ImageMagick (Debian: xvfb x11-apps
 # imagemagick); skipped when those are missing.
 if command -v Xvfb >/dev/null && command -v xwd >/dev/null && command -v convert >/dev/null; then

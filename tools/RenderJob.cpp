@@ -95,12 +95,13 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
     if (!job.quiet) {
       std::printf(
           "  frame %d: %ux%u, %d %s%s; bricks: %llu requested, %llu uploaded, %zu resident (pool %sB), "
-          "%zu in the frame; %.0f ms (trace %.0f, stream %.0f, upload %.0f; smoothing %.0f, normals %.0f, "
-          "shading %.0f) -> %s\n",
+          "%zu in the frame; %.0f ms (trace %.0f, stream %.0f, upload %.0f; g-buffer %.0f, smoothing %.0f, "
+          "normals %.0f, shading %.0f, read-back %.0f) -> %s\n",
           f, result.image.width, result.image.height, s.passes, s.passes == 1 ? "pass" : "passes",
           s.converged ? "" : " (pass limit: not converged)", (unsigned long long)s.bricksRequested,
           (unsigned long long)s.bricksUploaded, s.bricksResident, Progress::humanCount(double(s.poolBytes)).c_str(),
-          s.frameBricks, t.total, s.traceMs, s.streamMs, s.uploadMs, t.smoothing, t.normals, t.shading, path.c_str());
+          s.frameBricks, t.total, s.traceMs, s.streamMs, s.uploadMs, t.gbuffer, t.smoothing, t.normals, t.shading,
+          t.readback, path.c_str());
       std::fflush(stdout);
     }
     files.push_back({f, path, s, t});

@@ -113,7 +113,8 @@ void addRenderLookOptions(CLI::App& command, RenderLookArgs& a) {
                   "store records, else y), x, y or z")
       ->capture_default_str();
   cmd->add_option("--radius", args->radius,
-                  "Sphere radius in cells (default: the store's particle spacing, at least 1 cell)");
+                  "Sphere radius in cells (default: " + numberText(kDefaultRadiusPerSpacing) +
+                      " particle spacings of the store, at least 1 cell)");
   cmd->add_option("--smoothing", args->smoothing, "Surface filter: " + surfaceFilterNames())->capture_default_str();
   cmd->add_option("--smoothing-iterations", args->smoothingIterations,
                   "Filter iterations (default: the filter's; see README, Smoothing)");

@@ -48,7 +48,7 @@ SpillFile::SpillFile(const std::filesystem::path& directory)
     ::close(fd);
     throw OutputError(mDirectory, "cannot open a temporary file: " + reason);
   }
-  std::setvbuf(mFile, nullptr, _IOFBF, kBufferBytes);
+  mBuffer.attach(mFile, kBufferBytes);
 }
 
 SpillFile::~SpillFile() {

@@ -13,6 +13,8 @@
 #include <functional>
 #include <span>
 
+#include "core/StdioBuffer.h"
+
 namespace flipscope::detail {
 
 class SpillFile {
@@ -31,6 +33,7 @@ class SpillFile {
 
  private:
   std::filesystem::path mDirectory;  ///< for messages
+  StdioBuffer mBuffer;               ///< mFile's
   std::FILE* mFile = nullptr;
   std::uint64_t mSize = 0;
 };

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -279,6 +280,69 @@ TEST(StaleFiles, TemporaryNamesCarryTheWritersPid) {
   testing::TempDir temp("tmpname");
   AtomicFile file(temp / "frame_000003.fsf");
   EXPECT_EQ(temporaryFileOwner(file.temporaryPath().filename().string()), long(::getpid()));
+}
+
+/// RLIMIT_FSIZE at `bytes`, with SIGXFSZ ignored, for its lifetime: a write past it fails with
+/// EFBIG (File too large), as a full disk fails one with ENOSPC.
+class FileSizeLimit {
+ public:
+  explicit FileSizeLimit(rlim_t bytes) {
+    ::getrlimit(RLIMIT_FSIZE, &mSaved);
+    mSavedHandler = ::signal(SIGXFSZ, SIG_IGN);
+    rlimit limit = mSaved;
+    limit.rlim_cur = bytes;
+    EXPECT_EQ(::setrlimit(RLIMIT_FSIZE, &limit), 0);
+  }
+  ~FileSizeLimit() {
+    ::setrlimit(RLIMIT_FSIZE, &mSaved);
+    ::signal(SIGXFSZ, mSavedHandler);
+  }
+
+ private:
+  rlimit mSaved{};
+  sighandler_t mSavedHandler = SIG_DFL;
+};
+
+TEST(AtomicFile, AFailedWriteNamesTheDestinationAndItsTemporaryAndLeavesNeither) {
+  testing::TempDir temp("atomicfull");
+  const std::vector<std::byte> bytes(std::size_t(3) << 20, std::byte{7});
+  writeFileAtomically(temp / "kept.bin", std::span(bytes).first(100));
+  for (const bool large : {false, true}) {  // fails in commit's flush, or in a write past the buffer
+    SCOPED_TRACE(large ? "write" : "flush");
+    std::string message;
+    {
+      AtomicFile file(temp / "out.bin");
+      const FileSizeLimit limit(64);
+      try {
+        file.write(bytes.data(), large ? bytes.size() : 1000);  // 1000: within stdio's buffer
+        file.commit();
+      } catch (const OutputError& e) {
+        EXPECT_EQ(e.path(), temp / "out.bin");
+        message = e.what();
+      }
+    }
+    EXPECT_NE(message.find("out.bin: cannot be written: " + std::string(large ? "write" : "flush") +
+                           " of its temporary .out.bin.tmp-"),
+              std::string::npos)
+        << message;
+    EXPECT_NE(message.find("File too large"), std::string::npos) << message;
+    // Neither the destination nor a temporary is left, and the other file is whole.
+    std::vector<std::string> names;
+    for (const auto& entry : fs::directory_iterator(temp.path())) names.push_back(entry.path().filename().string());
+    EXPECT_EQ(names, std::vector<std::string>{"kept.bin"});
+    EXPECT_EQ(fs::file_size(temp / "kept.bin"), 100u);
+  }
+}
+
+TEST(AtomicFile, SmallWritesAreGatheredInItsBufferUntilCommit) {
+  testing::TempDir temp("atomicbuffer");
+  AtomicFile file(temp / "out.bin");
+  const std::vector<std::byte> piece(1000, std::byte{3});
+  const std::size_t pieces = kAtomicFileBufferBytes / piece.size() - 1;  // 1 MiB: far beyond 4 KiB
+  for (std::size_t i = 0; i < pieces; ++i) file.write(piece.data(), piece.size());
+  EXPECT_EQ(fs::file_size(file.temporaryPath()), 0u);  // nothing written yet: one write at commit
+  file.commit();
+  EXPECT_EQ(fs::file_size(temp / "out.bin"), pieces * piece.size());
 }
 
 TEST(StaleFiles, OnlyFilesOfProcessesThatAreGoneAreRemoved) {
