@@ -33,8 +33,7 @@ void runInfo(const InfoArgs& a) {
   if (!damage.empty() && !a.verify) {
     const std::vector<int> missing = store.missingFrames();
     if (missing.empty()) throw FileError(store.directory() / kStoreHeaderName, incompleteStoreReason());
-    std::string reason = std::string("missing: ") + kStoreHeaderName + " lists frame " + std::to_string(missing[0]) +
-                         ", but its file is gone";
+    std::string reason = store.missingFrameReason(missing[0]);
     if (missing.size() > 1)
       reason +=
           " (and " + std::to_string(missing.size() - 1) + " more listed frame(s) missing; info --verify lists them)";

@@ -610,11 +610,20 @@ std::filesystem::path BrickStore::framePath(int frame) const { return mDir / fra
 
 std::vector<int> BrickStore::missingFrames() const {
   std::vector<int> missing;
-  for (int f : frames()) {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(framePath(f), ec)) missing.push_back(f);
-  }
+  for (int f : frames())
+    if (!missingFrameReason(f).empty()) missing.push_back(f);
   return missing;
+}
+
+std::string BrickStore::missingFrameReason(int frame) const {
+  std::error_code ec;
+  const auto status = std::filesystem::status(framePath(frame), ec);
+  if (std::filesystem::is_regular_file(status)) return {};
+  const std::string listed = std::string("missing: ") + kStoreHeaderName + " lists frame " + std::to_string(frame);
+  if (!std::filesystem::exists(status)) return listed + ", but its file is gone";
+  return listed + ", but a " +
+         std::string(std::filesystem::is_directory(status) ? "directory" : "file that is not a regular file") +
+         " has its name";
 }
 
 std::vector<std::filesystem::path> BrickStore::unlistedFrameFiles() const {
@@ -680,10 +689,7 @@ std::shared_ptr<const FrameIndex> BrickStore::frame(int frame) const {
     if (auto it = mShared->indices.find(frame); it != mShared->indices.end()) return it->second;
   }
   const auto path = framePath(frame);
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec))
-    throw FileError(path, std::string("missing: ") + kStoreHeaderName + " lists frame " + std::to_string(frame) +
-                              ", but its file is gone");
+  if (const std::string missing = missingFrameReason(frame); !missing.empty()) throw FileError(path, missing);
   auto index = std::make_shared<const FrameIndex>(readFrameIndex(path, mHeader));
   if (index->frame != frame) throw FileError(path, "footer names frame " + std::to_string(index->frame));
   std::lock_guard lock(mShared->mutex);

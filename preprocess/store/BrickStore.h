@@ -209,8 +209,12 @@ class BrickStore {
   /// No frame yet: an interrupted or failed first convert.
   bool incomplete() const { return frames().empty(); }
   std::filesystem::path framePath(int frame) const;
-  /// Listed frames whose file does not exist, ascending.
+  /// Listed frames whose file is not a regular file (gone, or something else in its place),
+  /// ascending.
   std::vector<int> missingFrames() const;
+  /// Why listed frame `frame` has no file (for FileError on framePath(frame)): "missing: ...",
+  /// naming what is there instead when something is. Empty when its file is a regular file.
+  std::string missingFrameReason(int frame) const;
   /// Files in the directory named like frame files whose frame the table does not list.
   std::vector<std::filesystem::path> unlistedFrameFiles() const;
   /// Loads (once, then cached) and verifies a frame's footer, octree and table. Throws

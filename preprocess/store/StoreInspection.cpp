@@ -42,8 +42,7 @@ std::vector<std::string> checkFrameTable(const BrickStore& store) {
   if (store.incomplete())
     problems.push_back((store.directory() / kStoreHeaderName).string() + ": " + incompleteStoreReason());
   for (int f : store.missingFrames())
-    problems.push_back(store.framePath(f).string() + ": missing: " + kStoreHeaderName + " lists frame " +
-                       std::to_string(f) + ", but its file is gone");
+    problems.push_back(store.framePath(f).string() + ": " + store.missingFrameReason(f));
   return problems;
 }
 

@@ -201,15 +201,21 @@ TEST(FrameTable, ADeletedMiddleFrameIsMissingAndNamed) {
   makeStore(dir, {1, 2, 3, 4, 5});
   fs::remove(dir / "frame_000003.fsf");
   fs::remove(dir / "frame_000004.fsf");
+  fs::create_directory(dir / "frame_000004.fsf");  // something else in its place
   BrickStore store = BrickStore::open(dir);
   EXPECT_EQ(store.frames(), (std::vector<int>{1, 2, 3, 4, 5})) << "the table, not the directory";
   EXPECT_EQ(store.missingFrames(), (std::vector<int>{3, 4}));
-  expectFileError([&] { store.frame(3); }, {"frame_000003.fsf", "missing", "lists frame 3"});
+  expectFileError([&] { store.frame(3); }, {"frame_000003.fsf", "missing", "lists frame 3", "its file is gone"});
+  expectFileError([&] { store.frame(4); },
+                  {"frame_000004.fsf", "missing", "lists frame 4", "a directory has its name"});
   EXPECT_NO_THROW(store.frame(2));
+  EXPECT_EQ(store.missingFrameReason(2), "");
   const auto problems = checkFrameTable(store);
   ASSERT_EQ(problems.size(), 2u);
   EXPECT_NE(problems[0].find("frame_000003.fsf: missing"), std::string::npos) << problems[0];
-  EXPECT_NE(problems[1].find("frame_000004.fsf: missing"), std::string::npos) << problems[1];
+  EXPECT_NE(problems[1].find("frame_000004.fsf: missing: store.fsh lists frame 4, but a directory has its name"),
+            std::string::npos)
+      << problems[1];
 }
 
 TEST(FrameTable, AStoreWithoutFramesIsIncompleteAndTheNextStoreReplacesIt) {
