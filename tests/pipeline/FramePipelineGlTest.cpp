@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "OutputLayerChecks.h"
 #include "TestSupport.h"
 #include "core/Error.h"
 #include "pipeline/FramePipeline.h"
@@ -48,6 +49,14 @@ TEST(FramePipelineGl, EqualsTheCpuReference) {
   EXPECT_LT(depth, 2e-2);  // depths are ~150 world units
   EXPECT_LT(thickness, 1.5);  // one cell
   EXPECT_LT(colour, 0.05);
+}
+
+TEST(FramePipelineGl, TheColourAloneIsTheColourOfAllLayersAndLeavesTheOthersEmpty) {
+  try {
+    testing::expectTheColourAloneIsTheColourOfAllLayers(DeviceChoice::Gpu);
+  } catch (const gl::Unavailable& e) {
+    FLIPSCOPE_SKIP_WITHOUT_GL(e.what());
+  }
 }
 
 }  // namespace
