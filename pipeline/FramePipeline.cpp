@@ -12,6 +12,7 @@
 
 #include "core/Elapsed.h"
 #include "core/Error.h"
+#include "pipeline/GBufferPasses.h"
 #include "raycast/CpuRaycaster.h"
 #include "raycast/RaycastTypes.h"
 #include "smoothing/CpuScreenDevice.h"
@@ -21,18 +22,8 @@
 
 namespace flipscope {
 
-namespace glsl {
-struct GBufferKernel : CpuScreenKernel {
-#include "pipeline/glsl/GBuffer.glsl"
-};
-}  // namespace glsl
-
 namespace {
 using Clock = std::chrono::steady_clock;
-const ScreenPass kHits{"GBufferHits.comp", "gbufferHits",
-                       cpuScreenPass<glsl::GBufferKernel, &glsl::GBufferKernel::gbufferHits>};
-const ScreenPass kBlurThickness{"GBuffer.comp", "gbufferBlurThickness",
-                                cpuScreenPass<glsl::GBufferKernel, &glsl::GBufferKernel::gbufferBlurThickness>};
 }  // namespace
 
 namespace glsl {
@@ -269,7 +260,7 @@ void FramePipeline::shade(int frame, const Camera& camera, StageTimes& stages) {
   };
   device.setFrame(screenFrame(camera));
   timed(stages.gbuffer, [&] {
-    device.runPair(kHits, nullptr, 0, {s.hits}, s.thickness ? s.rawGbuffer : s.gbuffer, s.sphereNormals);
+    device.runPair(kGBufferHits, nullptr, 0, {s.hits}, s.thickness ? s.rawGbuffer : s.gbuffer, s.sphereNormals);
     if (s.thickness) device.run(kBlurThickness, nullptr, 0, {s.rawGbuffer}, s.gbuffer);
   });
   if (!s.filter->keepsDepth()) timed(stages.smoothing, [&] { s.filter->apply(device, s.gbuffer, s.smoothed); });
