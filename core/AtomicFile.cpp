@@ -189,7 +189,7 @@ AtomicFile::AtomicFile(std::filesystem::path destination) : mDestination(std::mo
     throw OutputError(mDestination, "cannot be written (its temporary " + mTemporary.filename().string() +
                                         " cannot be created: " + reason + ")");
   }
-  mBuffer.attach(mFile, kAtomicFileBufferBytes);
+  mBuffer.attach(mFile);
 }
 
 AtomicFile::~AtomicFile() {
@@ -202,7 +202,10 @@ AtomicFile::~AtomicFile() {
 
 void AtomicFile::write(const void* data, std::size_t bytes) {
   FLIPSCOPE_CHECK(mFile, "write after commit");
-  if (bytes && std::fwrite(data, 1, bytes, mFile) != bytes) throw temporaryFailure("write");
+  if (bytes && std::fwrite(data, 1, bytes, mFile) != bytes) {
+    const int error = errno;
+    throw temporaryFailure("write", error);
+  }
   mOffset += bytes;
 }
 
@@ -211,20 +214,27 @@ void AtomicFile::writeAt(std::uint64_t offset, const void* data, std::size_t byt
   FLIPSCOPE_CHECK(offset + bytes <= mOffset, "offset=" << offset << " bytes=" << bytes << " written=" << mOffset);
   if (::fseeko(mFile, static_cast<off_t>(offset), SEEK_SET) != 0 ||
       (bytes && std::fwrite(data, 1, bytes, mFile) != bytes) ||
-      ::fseeko(mFile, static_cast<off_t>(mOffset), SEEK_SET) != 0)
-    throw temporaryFailure("write at byte " + std::to_string(offset));
+      ::fseeko(mFile, static_cast<off_t>(mOffset), SEEK_SET) != 0) {
+    const int error = errno;
+    throw temporaryFailure("write at byte " + std::to_string(offset), error);
+  }
 }
 
-OutputError AtomicFile::temporaryFailure(const std::string& what) const {
-  const std::string reason = errnoText();  // before anything else can change errno
+OutputError AtomicFile::temporaryFailure(const std::string& what, int error) const {
   return OutputError(mDestination, "cannot be written: " + what + " of its temporary " +
-                                       mTemporary.filename().string() + " failed: " + reason);
+                                       mTemporary.filename().string() + " failed: " + std::strerror(error));
 }
 
 void AtomicFile::commit() {
   FLIPSCOPE_CHECK(mFile, "commit twice");
-  if (std::fflush(mFile) != 0) throw temporaryFailure("flush");
-  if (::fsync(::fileno(mFile)) != 0) throw temporaryFailure("fsync");
+  if (std::fflush(mFile) != 0) {
+    const int error = errno;
+    throw temporaryFailure("flush", error);
+  }
+  if (::fsync(::fileno(mFile)) != 0) {
+    const int error = errno;
+    throw temporaryFailure("fsync", error);
+  }
   std::fclose(mFile);
   mFile = nullptr;
   if (std::rename(mTemporary.c_str(), mDestination.c_str()) != 0) {

@@ -21,11 +21,10 @@
 #include <string_view>
 #include <vector>
 
+#include "core/Error.h"
 #include "core/StdioBuffer.h"
 
 namespace flipscope {
-
-class OutputError;
 
 /// Registers a path to remove when the process is stopped by SIGINT, SIGTERM or SIGHUP, for as
 /// long as the object lives (or until release()). Destroying it does not remove the path.
@@ -114,13 +113,14 @@ class AtomicFile {
   std::filesystem::path mDestination;
   std::filesystem::path mTemporary;
   CleanupOnSignal mCleanup;  ///< the temporary, until committed or removed
-  StdioBuffer mBuffer;       ///< mFile's
+  StdioBuffer mBuffer{kAtomicFileBufferBytes};  ///< mFile's
   std::FILE* mFile = nullptr;
   std::uint64_t mOffset = 0;
 
-  /// The error of a failed `what` ("write", "flush") on the temporary, with errno's reason:
-  /// it names the destination, the file the user asked for, and the temporary it was written to.
-  OutputError temporaryFailure(const std::string& what) const;
+  /// The error of a failed `what` ("write", "flush") on the temporary, with the reason of
+  /// `error` (the errno the failing call left): it names the destination, the file the user asked
+  /// for, and the temporary it was written to.
+  OutputError temporaryFailure(const std::string& what, int error) const;
 };
 
 /// Writes `bytes` to `destination` atomically.

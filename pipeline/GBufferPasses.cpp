@@ -28,7 +28,8 @@ void blurThicknessOnCpu(const CpuPassInputs& inputs, const void*, glm::vec4* out
   const int width = int(F.width), height = int(F.height);
   FLIPSCOPE_CHECK(inputs.sizes[0] >= std::size_t(width) * std::size_t(height), "the surface image is smaller");
   const glm::vec4* surface = inputs.images[0];
-  // gbufferBlurThickness's expressions, with glm's functions as the kernel compiled as C++ has them.
+  // gbufferBlurThickness's expressions, with the functions the kernel compiled as C++ calls
+  // (glm's clamp, min and max; std::abs).
   const float sameSurface = 4.0f * F.particleRadius;
   tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
     for (int y = rows.begin(); y != rows.end(); ++y) {
@@ -48,7 +49,7 @@ void blurThicknessOnCpu(const CpuPassInputs& inputs, const void*, glm::vec4* out
           const glm::vec4* row = surface + std::size_t(qy) * width;
           for (int qx = x0; qx <= x1; ++qx) {
             const glm::vec4& n = row[qx];
-            if (n.y < 0.5f || glm::abs(n.x - here.x) > sameSurface) continue;
+            if (n.y < 0.5f || std::abs(n.x - here.x) > sameSurface) continue;
             sum += n.z;
             count += 1.0f;
           }

@@ -9,6 +9,7 @@
 
 #include "core/Error.h"
 #include "core/NumberText.h"
+#include "raycast/FrameRenderer.h"
 #include "smoothing/SurfaceFilter.h"
 #include "smoothing/SurfaceShading.h"
 #include "tools/CliValues.h"

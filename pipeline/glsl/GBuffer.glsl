@@ -1,5 +1,5 @@
 // The ray-caster's hits as the G-buffer of the screen-space stages (Reichl et al. 2014 §3.3,
-// Fig. 3). Shared by GBufferHits.comp, GBuffer.comp and FramePipeline.cpp. Input 0 is the RayHit array
+// Fig. 3). Shared by GBufferHits.comp, GBuffer.comp and GBufferPasses.cpp. Input 0 is the RayHit array
 // (raycast/glsl/RaycastTypes.glsl) read as three vec4 per pixel: normal and attribute; t,
 // status, depth, brick; thickness, foam opacity and two unused floats.
 

@@ -17,8 +17,6 @@
 namespace flipscope::detail {
 namespace {
 
-constexpr std::size_t kBufferBytes = std::size_t(1) << 20;
-
 std::string errnoText() { return std::strerror(errno); }
 
 /// An open descriptor of a new unnamed file in `dir`, or -1 (errno set).
@@ -48,7 +46,7 @@ SpillFile::SpillFile(const std::filesystem::path& directory)
     ::close(fd);
     throw OutputError(mDirectory, "cannot open a temporary file: " + reason);
   }
-  mBuffer.attach(mFile, kBufferBytes);
+  mBuffer.attach(mFile);
 }
 
 SpillFile::~SpillFile() {

@@ -32,8 +32,9 @@ class SpillFile {
   void readBack(const std::function<void(std::span<const std::byte>)>& consume);
 
  private:
+  static constexpr std::size_t kBufferBytes = std::size_t(1) << 20;  ///< written and read back at a time
   std::filesystem::path mDirectory;  ///< for messages
-  StdioBuffer mBuffer;               ///< mFile's
+  StdioBuffer mBuffer{kBufferBytes};  ///< mFile's
   std::FILE* mFile = nullptr;
   std::uint64_t mSize = 0;
 };

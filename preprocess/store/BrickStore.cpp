@@ -620,6 +620,8 @@ std::string BrickStore::missingFrameReason(int frame) const {
   const auto status = std::filesystem::status(framePath(frame), ec);
   if (std::filesystem::is_regular_file(status)) return {};
   const std::string listed = std::string("missing: ") + kStoreHeaderName + " lists frame " + std::to_string(frame);
+  if (ec && ec != std::errc::no_such_file_or_directory)
+    return listed + ", but its file cannot be looked at: " + ec.message();
   if (!std::filesystem::exists(status)) return listed + ", but its file is gone";
   return listed + ", but a " +
          std::string(std::filesystem::is_directory(status) ? "directory" : "file that is not a regular file") +

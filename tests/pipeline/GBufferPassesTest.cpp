@@ -1,8 +1,10 @@
 // The CPU thickness blur against its reference, gbufferBlurThickness compiled from GBuffer.glsl.
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <cstring>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "pipeline/GBufferPasses.h"
@@ -31,8 +33,9 @@ TEST(GBufferPasses, TheCpuThicknessBlurIsItsReferenceBitForBit) {
   std::mt19937 random(11);
   std::uint64_t blurred = 0;  // foreground pixels compared
   for (const auto& [width, height] : {std::pair{1u, 1u}, {5u, 3u}, {37u, 29u}, {64u, 48u}}) {
-    // Blur radii from 1 to 8 pixels (focalPixels * particleRadius / depth, clamped).
-    for (const float focalPixels : {1.0f, 12.0f, 40.0f, 400.0f}) {
+    // Blur radii of 1 to 8 pixels: int(focalPixels * particleRadius / depth) clamped to [1, 8],
+    // over the two surfaces' depths (2 to 2.25, 3.25 to 3.5), gives 1; 1; 2 to 4; 3 to 6; 4 to 7; 8.
+    for (const float focalPixels : {1.0f, 12.0f, 40.0f, 52.0f, 64.0f, 400.0f}) {
       SCOPED_TRACE(::testing::Message() << width << "x" << height << ", focal " << focalPixels);
       const float radius = 0.25f;
       const std::vector<glm::vec4> surface = randomSurface(width, height, radius, random);
@@ -55,7 +58,6 @@ TEST(GBufferPasses, TheCpuThicknessBlurIsItsReferenceBitForBit) {
     }
   }
   EXPECT_GT(blurred, 5000u);
-  EXPECT_EQ(kBlurThickness.kernel, kBlurThicknessReference.kernel) << "one shader on the GPU";
 }
 
 }  // namespace
