@@ -202,10 +202,7 @@ AtomicFile::~AtomicFile() {
 
 void AtomicFile::write(const void* data, std::size_t bytes) {
   FLIPSCOPE_CHECK(mFile, "write after commit");
-  if (bytes && std::fwrite(data, 1, bytes, mFile) != bytes) {
-    const int error = errno;
-    throw temporaryFailure("write", error);
-  }
+  if (bytes && std::fwrite(data, 1, bytes, mFile) != bytes) throw temporaryFailure("write");
   mOffset += bytes;
 }
 
@@ -214,27 +211,22 @@ void AtomicFile::writeAt(std::uint64_t offset, const void* data, std::size_t byt
   FLIPSCOPE_CHECK(offset + bytes <= mOffset, "offset=" << offset << " bytes=" << bytes << " written=" << mOffset);
   if (::fseeko(mFile, static_cast<off_t>(offset), SEEK_SET) != 0 ||
       (bytes && std::fwrite(data, 1, bytes, mFile) != bytes) ||
-      ::fseeko(mFile, static_cast<off_t>(mOffset), SEEK_SET) != 0) {
-    const int error = errno;
-    throw temporaryFailure("write at byte " + std::to_string(offset), error);
-  }
+      ::fseeko(mFile, static_cast<off_t>(mOffset), SEEK_SET) != 0)
+    throw temporaryFailure("write", offset);
 }
 
-OutputError AtomicFile::temporaryFailure(const std::string& what, int error) const {
-  return OutputError(mDestination, "cannot be written: " + what + " of its temporary " +
-                                       mTemporary.filename().string() + " failed: " + std::strerror(error));
+OutputError AtomicFile::temporaryFailure(const char* what, std::optional<std::uint64_t> atByte) const {
+  const int error = errno;  // first: building the message allocates
+  return OutputError(mDestination, "cannot be written: " + std::string(what) +
+                                       (atByte ? " at byte " + std::to_string(*atByte) : std::string()) +
+                                       " of its temporary " + mTemporary.filename().string() +
+                                       " failed: " + std::strerror(error));
 }
 
 void AtomicFile::commit() {
   FLIPSCOPE_CHECK(mFile, "commit twice");
-  if (std::fflush(mFile) != 0) {
-    const int error = errno;
-    throw temporaryFailure("flush", error);
-  }
-  if (::fsync(::fileno(mFile)) != 0) {
-    const int error = errno;
-    throw temporaryFailure("fsync", error);
-  }
+  if (std::fflush(mFile) != 0) throw temporaryFailure("flush");
+  if (::fsync(::fileno(mFile)) != 0) throw temporaryFailure("fsync");
   std::fclose(mFile);
   mFile = nullptr;
   if (std::rename(mTemporary.c_str(), mDestination.c_str()) != 0) {

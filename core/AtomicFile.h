@@ -117,10 +117,11 @@ class AtomicFile {
   std::FILE* mFile = nullptr;
   std::uint64_t mOffset = 0;
 
-  /// The error of a failed `what` ("write", "flush") on the temporary, with the reason of
-  /// `error` (the errno the failing call left): it names the destination, the file the user asked
-  /// for, and the temporary it was written to.
-  OutputError temporaryFailure(const std::string& what, int error) const;
+  /// The error of a failed `what` ("write", "flush"; `atByte`: where a write went) on the
+  /// temporary, with the reason of the errno the failing call left (call it at once: it reads
+  /// errno before anything else): it names the destination, the file the user asked for, and
+  /// the temporary it was written to.
+  OutputError temporaryFailure(const char* what, std::optional<std::uint64_t> atByte = std::nullopt) const;
 };
 
 /// Writes `bytes` to `destination` atomically.
