@@ -10,6 +10,7 @@
 #include "core/ProcessMemory.h"
 #include "preprocess/Convert.h"
 #include "preprocess/particles/InputSequence.h"
+#include "preprocess/particles/ParticleFormatRegistry.h"
 #include "tools/CliChecks.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
@@ -101,8 +102,8 @@ void runConvert(const ConvertArgs& a) {
 
 void addConvertCommand(CLI::App& app) {
   auto args = std::make_shared<ConvertArgs>();
-  auto* cmd =
-      app.add_subcommand("convert", "Bin particle caches (.vdb, .ply, .bin/.raw, sequences) into a brick store");
+  auto* cmd = app.add_subcommand(
+      "convert", "Bin particle caches (" + supportedExtensions() + "; files, sequences, patterns) into a brick store");
   cmd->add_option("inputs", args->inputs,
                   "Input files or patterns (name_####.vdb, %04d, {}); several per frame merge into one frame")
       ->required();

@@ -114,9 +114,15 @@ const ParticleFormat* findParticleFormat(std::string_view name) {
 }
 
 std::string supportedExtensions() {
+  // Formats that share an ending (modern and classic .bgeo; RealFlow's and raw .bin) list it once.
+  std::vector<std::string_view> listed;
   std::string list;
   for (const auto& format : formatTable())
-    for (auto extension : format.extensions) list += (list.empty() ? "" : ", ") + std::string(extension);
+    for (auto extension : format.extensions) {
+      if (std::find(listed.begin(), listed.end(), extension) != listed.end()) continue;
+      listed.push_back(extension);
+      list += (list.empty() ? "" : ", ") + std::string(extension);
+    }
   return list;
 }
 

@@ -51,7 +51,7 @@ const ParticleFormat* findParticleFormat(std::string_view name);
 /// The length of the longest particle format extension the file name `fileName` ends with, in
 /// any case (".bgeo.sc" of "Splash.0001.BGEO.SC"); 0 when it ends with none.
 std::size_t particleExtensionLength(std::string_view fileName);
-/// "  .vdb .ply ..." for messages.
+/// ".vdb, .ply, ...": every extension once, in the table's order, for messages and help.
 std::string supportedExtensions();
 
 /// An opened input: the decoded bytes and what they are.

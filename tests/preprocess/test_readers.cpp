@@ -2,6 +2,7 @@
 // against an independent PLY encoder, and the error messages for malformed files.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -9,6 +10,7 @@
 #include "GzipTestWriter.h"
 #include "ParticleTestSupport.h"
 #include "preprocess/particles/InputFile.h"
+#include "preprocess/particles/ParticleFormatRegistry.h"
 
 namespace flipscope {
 namespace {
@@ -369,6 +371,22 @@ TEST(ParticleSource, DispatchByExtension) {
   expectFileError([&] { openParticleFile(dir / "p.xyz"); },
                   {"p.xyz", "unknown particle file format", ".vdb", ".ply", ".bin", ".raw"});
   expectFileError([&] { openParticleFile(dir / "missing.ply"); }, {"missing.ply", "no such file"});
+}
+
+// The list that unknown-format errors and `convert --help` give: every format's endings, each
+// once (modern and classic Houdini share .bgeo and .geo; RealFlow and raw floats share .bin).
+TEST(ParticleFormatRegistry, SupportedExtensionsNameEveryEndingOnce) {
+  const std::string list = supportedExtensions();
+  std::vector<std::string> items;
+  for (std::size_t at = 0; at <= list.size();) {
+    const std::size_t comma = std::min(list.find(", ", at), list.size());
+    items.push_back(list.substr(at, comma - at));
+    at = comma + 2;
+  }
+  for (const auto& format : particleFormats())
+    for (auto extension : format.extensions)
+      EXPECT_EQ(std::count(items.begin(), items.end(), std::string(extension)), 1) << extension << " in " << list;
+  for (const auto& item : items) EXPECT_EQ(particleExtensionLength("a" + item), item.size()) << item;
 }
 
 TEST(ParticleSource, VelocityOptionOff) {

@@ -317,6 +317,9 @@ TEST_F(Cli, HugePageAdviceOnOrOffWritesTheSameStore) {
   const CommandRun info = runFlipscope("info " + path("on"));
   ::unsetenv("FLIPSCOPE_HUGE_PAGES");
   EXPECT_EQ(help.exitCode, 0) << help.output;
+  // The help names what convert reads, from the format table.
+  for (const char* ending : {".vdb", ".bgeo.sc", ".prt", ".vtu", ".pdb", ".raw"})
+    EXPECT_NE(help.output.find(ending), std::string::npos) << ending << " in " << help.output;
   EXPECT_EQ(info.exitCode, 0) << info.output;
   ASSERT_EQ(on.exitCode, 0) << on.output;
   ASSERT_EQ(off.exitCode, 0) << off.output;
