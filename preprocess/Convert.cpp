@@ -15,6 +15,7 @@
 #include <memory>
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
@@ -26,6 +27,7 @@
 #include "preprocess/DirectFile.h"
 #include "preprocess/FiniteBounds.h"
 #include "preprocess/ParticleSpacing.h"
+#include "preprocess/PositionRanges.h"
 #include "preprocess/particles/PrefetchingSource.h"
 #include "preprocess/store/FrameFile.h"
 #include "preprocess/store/StoreLock.h"
@@ -513,8 +515,18 @@ ParticleSource& readingAhead(ParticleSource& source, bool readAhead, std::option
   return ahead.emplace(source);
 }
 
+/// The bounds of the finite positions of `source`: ranges of it on every core at once where the
+/// source reads ranges (readPositionRangesInParallel), else chunks in order.
 Box scanBounds(ParticleSource& source, std::size_t chunkParticles, bool readAhead, Progress* progress) {
+  tbb::enumerable_thread_specific<Box> rangeBounds;
+  const auto addRange = [&](std::span<const glm::vec3> positions, std::uint64_t) {
+    rangeBounds.local().extend(finiteBounds(positions).bounds);
+  };
   Box bounds;
+  if (readPositionRangesInParallel(source, addRange, progress)) {
+    for (const Box& b : rangeBounds) bounds.extend(b);
+    return bounds;
+  }
   ParticleChunk chunk;
   std::optional<PrefetchingSource> ahead;
   ParticleSource& input = readingAhead(source, readAhead, ahead);

@@ -25,6 +25,7 @@
 #include "core/Error.h"
 #include "core/NumberText.h"
 #include "preprocess/FiniteBounds.h"
+#include "preprocess/PositionRanges.h"
 
 namespace flipscope {
 namespace {
@@ -465,32 +466,20 @@ struct FiniteTally {
 };
 
 /// One read of every particle of `source` as candidates of `search`, ranges of it on every core
-/// at once, where the source reads a range of particles cheaply (readPositionRange: the reading
-/// no longer holds up the search), and their tally; else false, having read nothing.
+/// at once, where the source reads a range of particles cheaply (readPositionRangesInParallel:
+/// the reading no longer holds up the search), and their tally; else false, having read nothing.
 bool addInParallel(ParticleSource& source, KthNeighbours& search, FiniteTally& tally, Progress* progress) {
-  const std::optional<std::uint64_t> count = source.countHint();
-  std::vector<glm::vec3> none;
-  if (!count || !source.readPositionRange(0, 0, none)) return false;
-  struct Reader {
-    std::vector<glm::vec3> positions;
-    FiniteTally tally;
-  };
-  tbb::enumerable_thread_specific<Reader> readers;
-  const std::uint64_t ranges = (*count + kChunkParticles - 1) / kChunkParticles;
-  tbb::parallel_for(tbb::blocked_range<std::uint64_t>(0, ranges, 1), [&](const auto& r) {
-    Reader& reader = readers.local();
-    for (std::uint64_t i = r.begin(); i != r.end(); ++i) {
-      const std::uint64_t first = i * kChunkParticles;
-      const std::size_t n = std::size_t(std::min<std::uint64_t>(kChunkParticles, *count - first));
-      if (!source.readPositionRange(first, n, reader.positions))
-        throw LogicError(source.name() + ": the source stopped reading ranges of particles");
-      search.addConcurrently(reader.positions, first);
-      reader.tally.add(reader.positions);
-      if (progress) progress->advance(n);
-    }
-  });
+  tbb::enumerable_thread_specific<FiniteTally> tallies;
+  const bool read = readPositionRangesInParallel(
+      source,
+      [&](std::span<const glm::vec3> positions, std::uint64_t first) {
+        search.addConcurrently(positions, first);
+        tallies.local().add(positions);
+      },
+      progress);
+  if (!read) return false;
   search.flush();
-  for (const Reader& reader : readers) tally.add(reader.tally);
+  for (const FiniteTally& t : tallies) tally.add(t);
   return true;
 }
 

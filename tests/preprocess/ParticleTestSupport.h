@@ -10,12 +10,15 @@
 #include <fstream>
 #include <functional>
 #include <random>
+#include <span>
 #include <string>
+#include <vector>
 
+#include "TestSupport.h"
 #include "core/Error.h"
+#include "preprocess/particles/ParticleFormatRegistry.h"
 #include "preprocess/particles/ParticleSource.h"
 #include "preprocess/particles/ParticleWriter.h"
-#include "TestSupport.h"
 
 namespace flipscope::testing {
 
@@ -88,6 +91,58 @@ inline void expectFileError(const std::function<void()>& work, const std::vector
     std::string message = e.what();
     EXPECT_LT(message.size(), 1000u) << "message not kept short: " << message.substr(0, 300);
     for (const auto& part : parts) EXPECT_NE(message.find(part), std::string::npos) << "message: " << message;
+  }
+}
+
+/// Everything a source yields: positions, velocities and one value column per attribute.
+struct Everything {
+  ParticleChunk particles;
+  std::vector<std::vector<float>> columns;
+};
+
+/// Reads `source` to its end in chunks of at most `chunkSize`, checking each chunk's shape.
+inline Everything readEverything(ParticleSource& source, std::size_t chunkSize) {
+  Everything all;
+  ParticleChunk chunk;
+  while (source.read(chunk, chunkSize)) {
+    EXPECT_LE(chunk.size(), chunkSize);
+    EXPECT_EQ(chunk.velocities.size(), source.hasVelocity() ? chunk.size() : 0u);
+    all.particles.positions.insert(all.particles.positions.end(), chunk.positions.begin(), chunk.positions.end());
+    all.particles.velocities.insert(all.particles.velocities.end(), chunk.velocities.begin(), chunk.velocities.end());
+    all.columns.resize(chunk.attributes.size());
+    for (std::size_t i = 0; i < chunk.attributes.size(); ++i) {
+      EXPECT_EQ(chunk.attributes[i].values.size(), chunk.size() * std::size_t(chunk.attributes[i].arity));
+      all.columns[i].insert(all.columns[i].end(), chunk.attributes[i].values.begin(), chunk.attributes[i].values.end());
+    }
+  }
+  return all;
+}
+
+inline std::span<const std::byte> bytesOf(const std::string& text) {
+  return std::as_bytes(std::span(text.data(), text.size()));
+}
+
+/// Read options that read every attribute of a file.
+inline ReadOptions everyAttribute() {
+  ReadOptions options;
+  options.allAttributes = true;
+  return options;
+}
+
+/// Whether `bytes`, as a file named `name`, reads to its end with every attribute; a refusal must
+/// be a FileError naming the file. What it read goes to `out` when given.
+inline bool readsCompletely(const std::string& name, const std::string& bytes, Everything* out = nullptr) {
+  try {
+    auto source = openParticleBytes(name, bytesOf(bytes), everyAttribute());
+    Everything all = readEverything(*source, 64);
+    if (out) *out = std::move(all);
+    return true;
+  } catch (const FileError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(name + ": ", 0), 0u) << e.what();
+    return false;
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "not a FileError: " << e.what();
+    return false;
   }
 }
 

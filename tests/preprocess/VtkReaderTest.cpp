@@ -22,44 +22,16 @@ namespace flipscope {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::bytesOf;
+using testing::everyAttribute;
+using testing::Everything;
 using testing::expectFileError;
 using testing::LegacyVtkOptions;
+using testing::readEverything;
+using testing::readsCompletely;
 using testing::TempDir;
 using testing::VtkTestArray;
 using Kind = VtkTestArray::Kind;
-
-/// Everything a source yields: positions, velocities and one value column per attribute.
-struct Everything {
-  ParticleChunk particles;
-  std::vector<std::vector<float>> columns;
-};
-
-Everything readEverything(ParticleSource& source, std::size_t chunkSize) {
-  Everything all;
-  ParticleChunk chunk;
-  while (source.read(chunk, chunkSize)) {
-    EXPECT_LE(chunk.size(), chunkSize);
-    EXPECT_EQ(chunk.velocities.size(), source.hasVelocity() ? chunk.size() : 0u);
-    all.particles.positions.insert(all.particles.positions.end(), chunk.positions.begin(), chunk.positions.end());
-    all.particles.velocities.insert(all.particles.velocities.end(), chunk.velocities.begin(), chunk.velocities.end());
-    all.columns.resize(chunk.attributes.size());
-    for (std::size_t i = 0; i < chunk.attributes.size(); ++i) {
-      EXPECT_EQ(chunk.attributes[i].values.size(), chunk.size() * std::size_t(chunk.attributes[i].arity));
-      all.columns[i].insert(all.columns[i].end(), chunk.attributes[i].values.begin(), chunk.attributes[i].values.end());
-    }
-  }
-  return all;
-}
-
-std::span<const std::byte> bytesOf(const std::string& text) {
-  return std::as_bytes(std::span(text.data(), text.size()));
-}
-
-ReadOptions everyAttribute() {
-  ReadOptions options;
-  options.allAttributes = true;
-  return options;
-}
 
 // ---- The real file ----
 
@@ -387,31 +359,16 @@ struct Damage {
 
 /// Reads `bytes` completely with every attribute: false if refused with a FileError naming the
 /// file; any other exception fails the test.
-bool readsCompletely(const std::string& bytes, Everything* out = nullptr) {
-  try {
-    auto source = openParticleBytes("damaged.vtk", bytesOf(bytes), everyAttribute());
-    Everything all = readEverything(*source, 64);
-    if (out) *out = std::move(all);
-    return true;
-  } catch (const FileError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("damaged.vtk: ", 0), 0u) << e.what();
-    return false;
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "not a FileError: " << e.what();
-    return false;
-  }
-}
-
 void expectDamageRefused(const std::string& full, const std::string& label) {
   SCOPED_TRACE(label);
   Everything whole;
-  ASSERT_TRUE(readsCompletely(full, &whole));
+  ASSERT_TRUE(readsCompletely("damaged.vtk", full, &whole));
   // Truncation: refused, or (cut between sections, or only whitespace lost) a valid shorter file
   // that reads the same points and a prefix of the same attributes.
   std::size_t accepted = 0;
   for (std::size_t cut = 0; cut < full.size(); ++cut) {
     Everything part;
-    if (!readsCompletely(full.substr(0, cut), &part)) continue;
+    if (!readsCompletely("damaged.vtk", full.substr(0, cut), &part)) continue;
     ++accepted;
     ASSERT_EQ(part.particles.positions, whole.particles.positions) << "cut at " << cut;
     ASSERT_LE(part.columns.size(), whole.columns.size());
@@ -428,7 +385,7 @@ void expectDamageRefused(const std::string& full, const std::string& label) {
       std::string bad = full;
       bad[at] = char(static_cast<unsigned char>(bad[at]) ^ flip);
       ++damage.tries;
-      if (!readsCompletely(bad)) ++damage.refused;
+      if (!readsCompletely("damaged.vtk", bad)) ++damage.refused;
       if (::testing::Test::HasFailure()) return;
     }
   std::printf("%s: %zu bytes, %zu truncations valid, %zu of %zu changes refused\n", label.c_str(), full.size(),

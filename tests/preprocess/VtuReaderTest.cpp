@@ -19,40 +19,15 @@
 namespace flipscope {
 namespace {
 
+using testing::bytesOf;
+using testing::everyAttribute;
+using testing::Everything;
 using testing::expectFileError;
+using testing::readEverything;
+using testing::readsCompletely;
 using testing::VtkTestArray;
 using testing::VtuOptions;
 using Data = VtuOptions::Data;
-
-std::span<const std::byte> bytesOf(const std::string& text) {
-  return std::as_bytes(std::span(text.data(), text.size()));
-}
-
-ReadOptions everyAttribute() {
-  ReadOptions options;
-  options.allAttributes = true;
-  return options;
-}
-
-struct Everything {
-  ParticleChunk particles;
-  std::vector<std::vector<float>> columns;
-};
-
-Everything readEverything(ParticleSource& source, std::size_t chunkSize) {
-  Everything all;
-  ParticleChunk chunk;
-  while (source.read(chunk, chunkSize)) {
-    EXPECT_LE(chunk.size(), chunkSize);
-    EXPECT_EQ(chunk.velocities.size(), source.hasVelocity() ? chunk.size() : 0u);
-    all.particles.positions.insert(all.particles.positions.end(), chunk.positions.begin(), chunk.positions.end());
-    all.particles.velocities.insert(all.particles.velocities.end(), chunk.velocities.begin(), chunk.velocities.end());
-    all.columns.resize(chunk.attributes.size());
-    for (std::size_t i = 0; i < chunk.attributes.size(); ++i)
-      all.columns[i].insert(all.columns[i].end(), chunk.attributes[i].values.begin(), chunk.attributes[i].values.end());
-  }
-  return all;
-}
 
 std::vector<VtkTestArray> vtuArrays(std::size_t n) {
   return {testing::vtkTestArray("velocity", ValueType::Float32, 3, n, 1),
@@ -285,20 +260,6 @@ TEST(VtuReader, MessagesNameTheProblem) {
 
 // ---- Damage ----
 
-bool readsCompletely(const std::string& bytes) {
-  try {
-    auto source = openParticleBytes("damaged.vtu", bytesOf(bytes), everyAttribute());
-    readEverything(*source, 64);
-    return true;
-  } catch (const FileError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("damaged.vtu: ", 0), 0u) << e.what();
-    return false;
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "not a FileError: " << e.what();
-    return false;
-  }
-}
-
 bool blank(const std::string& text) {
   return std::all_of(text.begin(), text.end(), [](char c) { return c == ' ' || (c >= '\t' && c <= '\r'); });
 }
@@ -321,10 +282,10 @@ TEST(VtuReader, DamagedFilesAreRefused) {
     o.pieces = 2;
     const std::string full = testing::vtu(xyz, arrays, o);
     SCOPED_TRACE(describe(o));
-    ASSERT_TRUE(readsCompletely(full));
+    ASSERT_TRUE(readsCompletely("damaged.vtu", full));
     // Every truncation is refused, except one that cuts trailing whitespace only.
     for (std::size_t cut = 0; cut < full.size(); ++cut)
-      if (readsCompletely(full.substr(0, cut))) {
+      if (readsCompletely("damaged.vtu", full.substr(0, cut))) {
         ASSERT_TRUE(blank(full.substr(cut))) << "cut at " << cut;
       }
     std::size_t refused = 0, tries = 0;
@@ -333,7 +294,7 @@ TEST(VtuReader, DamagedFilesAreRefused) {
         std::string bad = full;
         bad[at] = char(static_cast<unsigned char>(bad[at]) ^ flip);
         ++tries;
-        if (!readsCompletely(bad)) ++refused;
+        if (!readsCompletely("damaged.vtu", bad)) ++refused;
         if (::testing::Test::HasFailure()) return;
       }
     std::printf("%s: %zu bytes, %zu of %zu changes refused\n", describe(o).c_str(), full.size(), refused, tries);
