@@ -22,7 +22,6 @@
 #include <glm/common.hpp>
 #include <glm/vec3.hpp>
 
-#include "core/Error.h"
 #include "core/NumberText.h"
 #include "preprocess/FiniteBounds.h"
 #include "preprocess/PositionRanges.h"

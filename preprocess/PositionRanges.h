@@ -26,9 +26,11 @@ using PositionRangeVisitor = std::function<void(std::span<const glm::vec3> posit
 /// Calls `visit` once for each of the consecutive ranges of kPositionRangeParticles particles
 /// (the last one shorter) that cover `source` (countHint()), several at once on different
 /// threads, and returns true; returns false, reading nothing and calling nothing, unless the
-/// source knows its count and reads ranges (readPositionRange). Progress, when given, advances by
-/// each range read. The source's next read() stays where it was. Throws FileError like the
-/// source, and what `visit` throws.
+/// source knows its count and reads ranges (readPositionRange). `visit` may run parallel work of
+/// its own: a range's positions stay as read until its visit returns. Progress, when given,
+/// advances by each range read. The source's next read() stays where it was. Throws FileError
+/// like the source, what `visit` throws, and LogicError when the source stops reading ranges
+/// part way.
 bool readPositionRangesInParallel(ParticleSource& source, const PositionRangeVisitor& visit,
                                   Progress* progress = nullptr);
 

@@ -114,7 +114,8 @@ const ParticleFormat* findParticleFormat(std::string_view name) {
 }
 
 std::string supportedExtensions() {
-  // Formats that share an ending (modern and classic .bgeo; RealFlow's and raw .bin) list it once.
+  // Formats that share an ending (modern and classic Houdini's .bgeo, .geo, .bgeo.gz, .geo.gz;
+  // RealFlow's and raw .bin) list it once.
   std::vector<std::string_view> listed;
   std::string list;
   for (const auto& format : formatTable())

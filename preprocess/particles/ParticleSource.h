@@ -97,7 +97,8 @@ class ParticleSource {
     (void)indices, (void)positions;
     return false;
   }
-  /// Random access by range, for reading a frame on several threads at once (ParticleSpacing.h):
+  /// Random access by range, for reading a frame on several threads at once (PositionRanges.h:
+  /// the spacing estimate's neighbour pass and convert's bounds pass):
   /// the positions of particles [first, first + count) (within countHint()) into `positions`
   /// (resized to match), leaving the next read() where it was. Thread safe: calls may overlap
   /// each other and one read() or readPositionsAt(). Returns false, reading nothing, unless the

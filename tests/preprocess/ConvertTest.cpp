@@ -9,15 +9,18 @@
 
 #include <tbb/task_arena.h>
 
+#include "GzipTestWriter.h"
+#include "ParticleTestSupport.h"
+#include "TestSupport.h"
+#include "VectorSource.h"
 #include "core/AtomicFile.h"
 #include "core/Error.h"
 #include "core/Morton.h"
 #include "preprocess/BrickBinning.h"
 #include "preprocess/Convert.h"
 #include "preprocess/ParticleSpacing.h"
+#include "preprocess/PositionRanges.h"
 #include "preprocess/particles/ParticleWriter.h"
-#include "TestSupport.h"
-#include "VectorSource.h"
 
 namespace flipscope {
 namespace {
@@ -305,6 +308,34 @@ ConvertOptions silent() {
   ConvertOptions options;
   options.progress = Progress::Mode::Silent;
   return options;
+}
+
+// The bounds pass reads a PLY by ranges on every core (readPositionRangesInParallel) and a gzip
+// around the same bytes in order: the same domain, from extremes and NaN/Inf in several ranges
+// (the last one short), and the same frame.
+TEST(Convert, TheBoundsPassFindsTheSameDomainByRangesAsInOrder) {
+  const std::size_t n = 3 * kPositionRangeParticles + 500;
+  auto positions = testing::randomParticles(n, 77u, 12.0f);
+  positions[10] = {std::nanf(""), 100, 100};
+  positions[kPositionRangeParticles + 3] = {-100, std::numeric_limits<float>::infinity(), 5};
+  positions[kPositionRangeParticles + 9] = {30.5f, -4.25f, 2};  // the far corner, in the second range
+  positions[n - 2] = {1, 2, -7.5f};                             // and in the last, short one
+  testing::TempDir temp("bounds-ranges");
+  writeRaw(temp / "p.ply", positions);
+  testing::writeBytes(temp / "p.ply.gz", testing::gzip(testing::readBytes(temp / "p.ply")));
+  ConvertOptions options = silent();
+  options.cellSize = 0.5;
+  options.particleSpacing = 0.25;  // no spacing estimate: its read would find the bounds instead
+  convert({{0, {temp / "p.ply"}}}, temp / "ranges", options);
+  convert({{0, {temp / "p.ply.gz"}}}, temp / "in-order", options);
+  const StoreHeader a = BrickStore::open(temp / "ranges").header();
+  const StoreHeader b = BrickStore::open(temp / "in-order").header();
+  EXPECT_EQ(a.origin, b.origin);
+  EXPECT_EQ(a.brickGrid, b.brickGrid);
+  EXPECT_EQ(a.origin.y, -4.25);  // the planted extremes
+  EXPECT_EQ(a.origin.z, -7.5);
+  EXPECT_EQ(BrickStore::open(temp / "ranges").frame(0)->stats.particles, n - 2);
+  EXPECT_EQ(BrickStore::open(temp / "in-order").frame(0)->stats.particles, n - 2);
 }
 
 TEST(ConvertSpacing, DefaultConvertOfMantaflowMakesOneCellPerParticleSpacing) {

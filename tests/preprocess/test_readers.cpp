@@ -374,7 +374,8 @@ TEST(ParticleSource, DispatchByExtension) {
 }
 
 // The list that unknown-format errors and `convert --help` give: every format's endings, each
-// once (modern and classic Houdini share .bgeo and .geo; RealFlow and raw floats share .bin).
+// once (modern and classic Houdini share .bgeo, .geo, .bgeo.gz and .geo.gz; RealFlow and raw
+// floats share .bin).
 TEST(ParticleFormatRegistry, SupportedExtensionsNameEveryEndingOnce) {
   const std::string list = supportedExtensions();
   std::vector<std::string> items;
