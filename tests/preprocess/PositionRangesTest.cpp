@@ -27,14 +27,15 @@ using testing::sameBits;
 using testing::TempDir;
 using testing::VectorSource;
 
-// Binary PLY without and with velocities (records of 12 and 24 bytes), a count that is no
-// multiple of the range.
+// Both readers that read ranges: binary PLY without and with velocities (records of 12 and 24
+// bytes) and raw floats; a count that is no multiple of the range.
 TEST(PositionRanges, ReadEveryParticleOnceWithItsRangesFirstParticle) {
   TempDir dir("ranges");
   const std::size_t n = 3 * kPositionRangeParticles + 123;
-  for (const bool velocity : {false, true}) {
+  for (const char* name : {"p.ply", "v.ply", "r.raw"}) {
+    const bool velocity = std::string(name) == "v.ply";
     const ParticleChunk particles = randomParticles(n, velocity, velocity ? 8u : 7u);
-    const auto path = dir / (velocity ? "v.ply" : "p.ply");
+    const auto path = dir / name;
     testing::writeFile(path, particles, WriteOptions{});
     auto source = openParticleFile(path);
     ParticleChunk chunk;
