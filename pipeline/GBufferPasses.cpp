@@ -17,10 +17,11 @@ struct GBufferKernel : CpuScreenKernel {
 
 const ScreenPass kGBufferHits{"GBufferHits.comp", "gbufferHits",
                               cpuScreenPass<glsl::GBufferKernel, &glsl::GBufferKernel::gbufferHits>};
-const ScreenPass kBlurThickness{"GBuffer.comp", "gbufferBlurThickness", blurThicknessOnCpu};
 const ScreenPass kBlurThicknessReference{
     "GBuffer.comp", "gbufferBlurThickness",
     cpuScreenPass<glsl::GBufferKernel, &glsl::GBufferKernel::gbufferBlurThickness>};
+// The reference's shader and kernel, so that the GPU runs the one shader whichever is asked for.
+const ScreenPass kBlurThickness{kBlurThicknessReference.shader, kBlurThicknessReference.kernel, blurThicknessOnCpu};
 
 void blurThicknessOnCpu(const CpuPassInputs& inputs, const void*, glm::vec4* output, glm::vec4* secondOutput) {
   FLIPSCOPE_CHECK(secondOutput == nullptr, "a pass of one output run with two");
