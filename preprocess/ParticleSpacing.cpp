@@ -482,6 +482,77 @@ bool addInParallel(ParticleSource& source, KthNeighbours& search, FiniteTally& t
   return true;
 }
 
+/// Each point's k-th neighbour distance among the other points (detail::kthNeighbourDistancesAmong).
+/// Points, not lists of queries within reach, go into cells at least as wide as the radius:
+/// candidates and queries are the same points, so no cell turns a candidate away, and each
+/// point lies in one cell only. A query measures the points of the 3 cells along x of each of
+/// its 9 rows (y, z), one run each, since the points are sorted by cell (a counting sort). The
+/// cells are at most kCellsPerPoint a point, coarser where the radius is far below the spread.
+std::vector<double> kthAmongPoints(std::span<const glm::vec3> points, double radius) {
+  const std::size_t n = points.size();
+  std::vector<double> kth(n, std::numeric_limits<double>::infinity());
+  if (n <= kNeighbours || !(radius > 0)) return kth;
+  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
+  for (const glm::vec3& p : points) {
+    lo = glm::min(lo, glm::dvec3(p));
+    hi = glm::max(hi, glm::dvec3(p));
+  }
+  const glm::dvec3 extent = hi - lo;
+  if (!std::isfinite(extent.x + extent.y + extent.z)) return kth;
+  // A neighbour within the radius (its float distance, rounded by up to 3e-7 relative) lies in
+  // a cell next to the query's when the cells are a little wider than the radius; a coordinate
+  // in cells (at most kCellsPerPoint * n of them) is exact to far below that margin.
+  constexpr double kCellsPerPoint = 4;
+  double cell = radius * (1 + 1e-5);
+  const auto cellsFor = [&](double c) { return glm::floor(extent / c) + 3.0; };  // a cell of margin each side
+  glm::dvec3 dims = cellsFor(cell);
+  const double maxCells = std::max(4096.0, kCellsPerPoint * double(n));
+  while (!(dims.x * dims.y * dims.z <= maxCells)) {
+    cell *= std::max(1.01, std::cbrt(dims.x * dims.y * dims.z / maxCells) * 1.01);
+    dims = cellsFor(cell);
+  }
+  const std::size_t dx = std::size_t(dims.x), dxy = dx * std::size_t(dims.y);
+  const auto cellOf = [&](const glm::vec3& p) {
+    const glm::dvec3 c = glm::floor((glm::dvec3(p) - lo) / cell) + 1.0;
+    return std::size_t(c.z) * dxy + std::size_t(c.y) * dx + std::size_t(c.x);
+  };
+  std::vector<std::uint32_t> start(std::size_t(dims.x * dims.y * dims.z) + 1, 0);
+  std::vector<std::uint32_t> cells(n);
+  for (std::size_t i = 0; i < n; ++i) ++start[(cells[i] = std::uint32_t(cellOf(points[i]))) + 1];
+  for (std::size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
+  std::vector<glm::vec3> sorted(n);
+  std::vector<std::uint32_t> original(n);
+  {
+    std::vector<std::uint32_t> next(start.begin(), start.end() - 1);
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::uint32_t k = next[cells[i]]++;
+      sorted[k] = points[i];
+      original[k] = std::uint32_t(i);
+    }
+  }
+  const float radius2 = float(radius * radius);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& range) {
+    std::vector<float> near;
+    for (std::size_t k = range.begin(); k != range.end(); ++k) {
+      near.clear();
+      const glm::vec3 q = sorted[k];
+      const std::size_t c = cells[original[k]];
+      for (std::size_t row :
+           {c - dxy - dx, c - dxy, c - dxy + dx, c - dx, c, c + dx, c + dxy - dx, c + dxy, c + dxy + dx})
+        for (std::size_t j = start[row - 1]; j < start[row + 2]; ++j) {
+          const glm::vec3 d = q - sorted[j];
+          const float d2 = d.x * d.x + d.y * d.y + d.z * d.z;
+          if (d2 <= radius2 && j != k) near.push_back(d2);
+        }
+      if (near.size() < kNeighbours) continue;
+      std::nth_element(near.begin(), near.begin() + (kNeighbours - 1), near.end());
+      const double d2 = near[kNeighbours - 1];
+      if (d2 <= radius * radius) kth[original[k]] = std::sqrt(d2);
+    }
+  });
+  return kth;
+}
+
 /// Samples at least this large start medianWithinSample's search from a thinned part of them.
 constexpr std::size_t kThinnedStart = 4000;
 
@@ -518,7 +589,6 @@ double medianWithinSample(const Sample& s) {
     Sample part;
     for (std::size_t j = 0; j < n; j += 8) {
       part.positions.push_back(s.positions[j]);
-      part.ids.push_back(s.ids[j]);
     }
     const double partMedian = medianWithinSample(part);
     if (std::isfinite(partMedian) && partMedian > 0)
@@ -526,10 +596,10 @@ double medianWithinSample(const Sample& s) {
   }
   // Beyond 2 * longest every query has every other particle (n > k) within the radius.
   for (int attempt = 0; attempt < 64; ++attempt, radius *= 2) {
-    KthNeighbours search(s, std::min(radius, 2 * longest));
-    search.add(s.positions, s.ids);
-    const double median = search.median();
-    if (std::isfinite(median)) return median;
+    std::vector<double> kth = kthAmongPoints(s.positions, std::min(radius, 2 * longest));
+    const auto mid = kth.begin() + std::ptrdiff_t(n / 2);
+    std::nth_element(kth.begin(), mid, kth.end());
+    if (std::isfinite(*mid)) return *mid;
     if (radius >= 2 * longest) break;
   }
   return std::numeric_limits<double>::infinity();
@@ -608,6 +678,10 @@ SpacingEstimate neighbourSpacing(ParticleSource& source, std::size_t sampleSize,
   e.origin =
       "median " + std::to_string(kSpacingNeighbour) + "th-neighbour distance " + numberText(median) + " of " + of;
   return e;
+}
+
+std::vector<double> detail::kthNeighbourDistancesAmong(std::span<const glm::vec3> points, double radius) {
+  return kthAmongPoints(points, radius);
 }
 
 std::vector<double> detail::kthNeighbourDistances(std::span<const glm::vec3> queries,

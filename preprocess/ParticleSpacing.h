@@ -75,6 +75,10 @@ namespace detail {
 /// has id i; a candidate with a query's id is that query itself and does not count.
 std::vector<double> kthNeighbourDistances(std::span<const glm::vec3> queries, std::span<const std::uint64_t> queryIds,
                                           std::span<const glm::vec3> candidates, double radius);
+/// The search among the sample itself (queries and candidates the same points, a point not its
+/// own neighbour): kthNeighbourDistances(points, 0..n-1, points, radius), found without lists of
+/// queries by cell. The thinned starts of the estimate's radius run it.
+std::vector<double> kthNeighbourDistancesAmong(std::span<const glm::vec3> points, double radius);
 }  // namespace detail
 
 }  // namespace flipscope

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <numeric>
 #include <random>
 
 #include <glm/common.hpp>
@@ -115,6 +116,58 @@ TEST(ParticleSpacing, TheSearchFindsTheKthNeighboursOfComparingEveryPair) {
     EXPECT_GT(within, 0u);
     EXPECT_LT(within, queries.size()) << "some queries' 12th neighbour lies beyond the radius";
   }
+}
+
+TEST(ParticleSpacing, TheSearchAmongTheSampleFindsWhatTheSearchOfQueriesFinds) {
+  // The estimate's start (the median within the sample) searches the sampled points among
+  // themselves (detail::kthNeighbourDistancesAmong). It must give each point the distance the
+  // search of queries gives it with the same points as candidates, bit for bit: on clusters of
+  // different densities, a sheet, coincident points and a lattice whose neighbours lie exactly
+  // a radius (and a cell face) apart; at radii far below the spacing (whose cells it coarsens),
+  // around it, and beyond the spread.
+  std::mt19937 rng(5);
+  std::vector<glm::vec3> points;
+  for (const float spread : {0.03f, 0.3f}) {
+    std::normal_distribution<float> blob(0.0f, spread);
+    for (int i = 0; i < 1500; ++i)
+      points.push_back(glm::vec3(spread * 8, 0, 0) + glm::vec3(blob(rng), blob(rng), blob(rng)));
+  }
+  std::uniform_real_distribution<float> sheet(-2.0f, 2.0f);
+  for (int i = 0; i < 800; ++i) points.push_back({sheet(rng), 3.0f, sheet(rng)});
+  for (int i = 0; i < 20; ++i) points.push_back(points[std::size_t(i) * 7]);  // coincident
+  for (int x = 0; x < 6; ++x)
+    for (int y = 0; y < 6; ++y)
+      for (int z = 0; z < 6; ++z) points.push_back(glm::vec3(-5.0f) + 0.25f * glm::vec3(x, y, z));
+  std::vector<std::uint64_t> ids(points.size());
+  std::iota(ids.begin(), ids.end(), 0);
+  for (const double radius : {1e-4, 0.02, 0.25, 0.5, 3.0, 40.0}) {
+    const std::vector<double> among = detail::kthNeighbourDistancesAmong(points, radius);
+    const std::vector<double> expected = detail::kthNeighbourDistances(points, ids, points, radius);
+    ASSERT_EQ(among.size(), points.size());
+    std::size_t within = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      within += std::isfinite(expected[i]);
+      ASSERT_EQ(among[i], expected[i]) << "point " << i << " at radius " << radius;
+    }
+    if (radius == 0.25) {
+      EXPECT_GT(within, 0u);
+      EXPECT_LT(within, points.size());
+    }
+  }
+  // Groups of 12 coincident points and one exactly a radius (0.25) along x: the 12th neighbour of
+  // each point is 0.25 away. The groups start at every 4096th of a radius along x, so some lie
+  // just below a cell face and their 12th neighbour just above the next one.
+  std::vector<glm::vec3> groups;
+  for (int i = 0; i <= 4096; ++i) {
+    const glm::vec3 base(float(i) / 16384.0f, 0.75f * float(i), 0.0f);
+    for (int c = 0; c < kSpacingNeighbour; ++c) groups.push_back(base);
+    groups.push_back(base + glm::vec3(0.25f, 0.0f, 0.0f));
+  }
+  const std::vector<double> grouped = detail::kthNeighbourDistancesAmong(groups, 0.25);
+  for (std::size_t i = 0; i < groups.size(); ++i) ASSERT_EQ(grouped[i], 0.25) << "point " << i;
+  EXPECT_EQ(detail::kthNeighbourDistancesAmong(std::span(points).first(kSpacingNeighbour), 40.0),
+            std::vector<double>(kSpacingNeighbour, std::numeric_limits<double>::infinity()))
+      << "12 points have 11 neighbours each";
 }
 
 TEST(ParticleSpacing, TheSearchFindsNeighboursExactlyAtTheRadiusOnTheFacesOfItsCells) {
