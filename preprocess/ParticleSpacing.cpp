@@ -37,6 +37,11 @@ constexpr double kMaxSearchCells = double(std::size_t(1) << 25);
 /// ... and at most this many along an axis (a bound on the rounding of cellsOf).
 constexpr double kMaxAxisCells = 4096;
 
+/// How far beyond `radius` a candidate may lie whose float squared distance is rounded down to
+/// float(radius^2) where the squares are subnormal (coordinates below about 1e-19): a few of
+/// their quantum, denorm_min, over twice the radius. The searches' cells reach this much further.
+double subnormalMargin(double radius) { return 4 * double(std::numeric_limits<float>::denorm_min()) / radius; }
+
 /// Spacing per k-th neighbour distance r: at spacing r * ballFactor(), a ball of radius r holds k particles.
 double ballFactor() { return std::cbrt(4 * std::numbers::pi / (3 * double(kSpacingNeighbour))); }
 
@@ -165,8 +170,11 @@ std::optional<Sample> sampleByNumber(ParticleSource& source, std::size_t size) {
 /// of some point of it. A candidate looks up its own cell only (found in floats, four at a
 /// time): a bit turns it away when the list is empty (most candidates lie far from every query),
 /// else it measures its distance to each listed query. The reach is the radius plus a margin for
-/// the rounding of a candidate's cell, so the lists are a superset and the search is exact. A
-/// candidate with the id of a query is that query itself and skipped.
+/// the rounding of a candidate's cell, so the lists are a superset and the search is exact. Where
+/// the bits' cells came out coarser than kFineCellRatio radii (queries far apart), their lists
+/// would hold many queries out of reach of most candidates; the lists are then of cells of the
+/// radius, of those near a query only, found through a hash table (buildFineLists), and the bits
+/// only turn candidates away. A candidate with the id of a query is that query itself and skipped.
 class KthNeighbours {
  public:
   /// Cells of the radius, not of half of it, for the frame's pass too: there, fewer candidates
@@ -241,6 +249,10 @@ class KthNeighbours {
   static constexpr float kInf = std::numeric_limits<float>::infinity();
   /// Candidates whose cells are found at a time (cellsOf).
   static constexpr std::size_t kBlock = 256;
+  /// The margins of the reach (buildCellLists).
+  static constexpr double kSlack = 1e-6, kCellSlack = 0x1p-9;
+  /// Cells of the bits coarser than this many radii get lists of cells of the radius (buildFineLists).
+  static constexpr double kFineCellRatio = 2;
 
   /// v as a float (exactly), rounded down (`direction` -1) or up (+1).
   static double roundedToFloat(double v, int direction) {
@@ -249,18 +261,25 @@ class KthNeighbours {
     return f;
   }
 
-  /// Calls visit(bit) for each cell within reach of `query`: whose box holds a point at most
-  /// `reach` from it.
+  /// Cells of the radius (or coarser) over [lo, lo + cell * dims).
+  struct CellGrid {
+    glm::dvec3 lo{0};
+    double cell = 0, inverse = 0;
+    glm::ivec3 dims{0};
+  };
+
+  /// Calls visit(x, y, z) for each cell of `grid` within reach of `query`: whose box holds a point
+  /// at most `reach` from it.
   template <class Visit>
-  void forEachCellNear(const glm::vec3& query, double reach, Visit visit) {
+  void forEachCellNear(const CellGrid& grid, const glm::vec3& query, double reach, Visit visit) {
     const glm::dvec3 q(query);
     glm::ivec3 first, last;
     for (int a = 0; a < 3; ++a) {
-      first[a] = std::max(0, int(std::floor((q[a] - reach - mLo[a]) * mInverseCell)));
-      last[a] = std::min(mDims[a] - 1, int(std::floor((q[a] + reach - mLo[a]) * mInverseCell)));
+      first[a] = std::max(0, int(std::floor((q[a] - reach - grid.lo[a]) * grid.inverse)));
+      last[a] = std::min(grid.dims[a] - 1, int(std::floor((q[a] + reach - grid.lo[a]) * grid.inverse)));
       mAxisDistance2[a].clear();
       for (int i = first[a]; i <= last[a]; ++i) {
-        const double lo = mLo[a] + i * mCell, hi = lo + mCell;
+        const double lo = grid.lo[a] + i * grid.cell, hi = lo + grid.cell;
         const double d = std::max({lo - q[a], 0.0, q[a] - hi});
         mAxisDistance2[a].push_back(d * d);
       }
@@ -270,9 +289,8 @@ class KthNeighbours {
       for (int y = first.y; y <= last.y; ++y) {
         const double yz = mAxisDistance2[2][std::size_t(z - first.z)] + mAxisDistance2[1][std::size_t(y - first.y)];
         if (yz > reach2) continue;
-        const std::size_t row = (std::size_t(z) * std::size_t(mDims.y) + std::size_t(y)) * std::size_t(mDims.x);
         for (int x = first.x; x <= last.x; ++x)
-          if (yz + mAxisDistance2[0][std::size_t(x - first.x)] <= reach2) visit(row + std::size_t(x));
+          if (yz + mAxisDistance2[0][std::size_t(x - first.x)] <= reach2) visit(x, y, z);
       }
   }
 
@@ -301,8 +319,7 @@ class KthNeighbours {
     // be one whose box it misses by three float roundings of its coordinate in cells (at most
     // kMaxAxisCells): 3 * 2^-24 * 4096 = 0.0007 cells; kSlack, the double rounding of the
     // distances from a query to the cells' boxes (forEachCellNear).
-    constexpr double kSlack = 1e-6, kCellSlack = 0x1p-9;
-    const double reach = mRadius * (1 + kSlack) + mCell * kCellSlack;
+    const double reach = mRadius * (1 + kSlack) + mCell * kCellSlack + subnormalMargin(mRadius);
     // Queries in the order of their cells, so that the cells each visits next lie in memory near
     // those of the one before: each pass below walks the bits and lists about in order.
     const std::size_t n = mQueries.positions.size();
@@ -313,14 +330,21 @@ class KthNeighbours {
     // millions of pairs of fresh memory): the bits; each list's length; the lists, filled from
     // their ends (the order within a list is of no account). In between, the rank of each word's
     // first bit and the lists' ends.
+    const CellGrid grid{mLo, mCell, mInverseCell, mDims};
     const auto forEachPair = [&](auto visit) {
       for (const auto& entry : order) {
         const std::uint32_t j = entry.second;
-        forEachCellNear(mQueries.positions[j], reach, [&](std::size_t bit) { visit(bit, j); });
+        forEachCellNear(grid, mQueries.positions[j], reach, [&](int x, int y, int z) {
+          visit((std::size_t(z) * std::size_t(mDims.y) + std::size_t(y)) * std::size_t(mDims.x) + std::size_t(x), j);
+        });
       }
     };
     mBits.assign(words, 0);
     forEachPair([&](std::size_t bit, std::uint32_t) { mBits[bit / 64] |= std::uint64_t(1) << (bit % 64); });
+    if (mCell > kFineCellRatio * mRadius) {
+      buildFineLists(order);
+      return;
+    }
     mWordRank.resize(words + 1);
     mWordRank[0] = 0;
     for (std::size_t w = 0; w < words; ++w) mWordRank[w + 1] = mWordRank[w] + std::uint32_t(std::popcount(mBits[w]));
@@ -331,6 +355,62 @@ class KthNeighbours {
     mListStart[lists] = lists ? mListStart[lists - 1] : 0;
     mListed.resize(mListStart[lists]);
     forEachPair([&](std::size_t bit, std::uint32_t j) { mListed[--mListStart[listOf(bit, mBits[bit / 64])]] = j; });
+  }
+
+  /// The lists where the cells of the bits are coarser than kFineCellRatio radii (queries far
+  /// apart: two tanks, a particle flung far away, or a box too large for kMaxSearchCells cells of
+  /// the radius), whose lists would hold many queries beyond the reach of most of their
+  /// candidates: lists of cells of the radius again, of the occupied cells only, found by a hash
+  /// table of their keys (fineListOf). The bits still turn away the candidates far from every
+  /// query.
+  void buildFineLists(std::span<const std::pair<std::size_t, std::uint32_t>> order) {
+    const glm::dvec3 extent = mHi - mLo;
+    constexpr double kAxisCells = double((1 << 21) - 2);  // a key holds 21 bits an axis
+    mFine.lo = mLo;
+    mFine.cell = std::max(mRadius, std::max({extent.x, extent.y, extent.z}) / kAxisCells);
+    mFine.inverse = 1 / mFine.cell;
+    mFine.dims = glm::ivec3(glm::floor(extent * mFine.inverse) + 1.0);
+    // The reach's margins as in buildCellLists; the candidates' fine cells are found in doubles.
+    const double reach = mRadius * (1 + kSlack) + mFine.cell * kCellSlack + subnormalMargin(mRadius);
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> pairs;  // (fine cell, query)
+    for (const auto& entry : order)
+      forEachCellNear(mFine, mQueries.positions[entry.second], reach, [&](int x, int y, int z) {
+        pairs.push_back({fineKey(x, y, z), entry.second});
+      });
+    std::sort(pairs.begin(), pairs.end());
+    mListed.resize(pairs.size());
+    mListStart.clear();
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+      if (i == 0 || pairs[i].first != pairs[i - 1].first) {
+        mFineKeys.push_back(pairs[i].first);
+        mListStart.push_back(std::uint32_t(i));
+      }
+      mListed[i] = pairs[i].second;
+    }
+    mListStart.push_back(std::uint32_t(pairs.size()));
+    const std::size_t slots = std::bit_ceil(std::max<std::size_t>(2, 2 * mFineKeys.size()));
+    mFineShift = 64 - std::countr_zero(slots);
+    mFineTable.assign(slots, 0);
+    for (std::size_t list = 0; list < mFineKeys.size(); ++list) {
+      std::size_t s = fineSlot(mFineKeys[list]);
+      while (mFineTable[s]) s = (s + 1) & (slots - 1);
+      mFineTable[s] = std::uint32_t(list + 1);
+    }
+  }
+
+  static std::uint64_t fineKey(int x, int y, int z) {
+    return (std::uint64_t(z) << 42) | (std::uint64_t(y) << 21) | std::uint64_t(x);
+  }
+  std::size_t fineSlot(std::uint64_t key) const { return std::size_t((key * 0x9e3779b97f4a7c15ull) >> mFineShift); }
+
+  /// The list of the fine cell of candidate p (inside [mLo, mHi]), or -1 where none is near.
+  std::int64_t fineListOf(const glm::vec3& p) const {
+    const glm::ivec3 c =
+        glm::clamp(glm::ivec3(glm::floor((glm::dvec3(p) - mFine.lo) * mFine.inverse)), glm::ivec3(0), mFine.dims - 1);
+    const std::uint64_t key = fineKey(c.x, c.y, c.z);
+    for (std::size_t s = fineSlot(key); mFineTable[s]; s = (s + 1) & (mFineTable.size() - 1))
+      if (mFineKeys[mFineTable[s] - 1] == key) return std::int64_t(mFineTable[s] - 1);
+    return -1;
   }
 
   /// The bit of the cell of p, a point inside [mLo, mHi].
@@ -372,7 +452,12 @@ class KthNeighbours {
         if (cells[k] < 0) continue;
         const std::size_t bit = std::size_t(cells[k]);
         const std::uint64_t word = mBits[bit / 64];
-        if (word >> (bit % 64) & 1) measure(candidates[first + k], idOf(first + k), listOf(bit, word), hits);
+        if (!(word >> (bit % 64) & 1)) continue;
+        if (mFineKeys.empty()) {
+          measure(candidates[first + k], idOf(first + k), listOf(bit, word), hits);
+        } else if (const std::int64_t list = fineListOf(candidates[first + k]); list >= 0) {
+          measure(candidates[first + k], idOf(first + k), std::size_t(list), hits);
+        }
       }
     }
   }
@@ -441,7 +526,12 @@ class KthNeighbours {
   glm::ivec3 mDims{0};                    ///< of the cells over [mLo, mHi]
   std::vector<std::uint64_t> mBits;       ///< a bit per cell (x fastest): its list is not empty
   std::vector<std::uint32_t> mWordRank;   ///< per word of mBits, the set bits before it
-  std::vector<std::uint32_t> mListStart;  ///< per set bit, its list's first entry in mListed; then the end
+  std::vector<std::uint32_t>
+      mListStart;  ///< per set bit (per fine cell), its list's first entry in mListed; then the end
+  CellGrid mFine;  ///< buildFineLists' cells, where it ran
+  std::vector<std::uint64_t> mFineKeys;   ///< per fine list, its cell's key (fineKey); empty: the bits' lists
+  std::vector<std::uint32_t> mFineTable;  ///< open addressing: a fine list + 1, or 0
+  int mFineShift = 64;
   std::vector<std::uint32_t> mListed;     ///< the queries of each list
   std::vector<double> mAxisDistance2[3];  ///< forEachCellNear's scratch
   std::vector<float> mHeaps;  ///< k squared distances per query, a max-heap each
@@ -483,15 +573,17 @@ bool addInParallel(ParticleSource& source, KthNeighbours& search, FiniteTally& t
 }
 
 /// Each point's k-th neighbour distance among the other points (detail::kthNeighbourDistancesAmong).
-/// Points, not lists of queries within reach, go into cells at least as wide as the radius:
-/// candidates and queries are the same points, so no cell turns a candidate away, and each
-/// point lies in one cell only. A query measures the points of the 3 cells along x of each of
-/// its 9 rows (y, z), one run each, since the points are sorted by cell (a counting sort). The
-/// cells are at most kCellsPerPoint a point, coarser where the radius is far below the spread.
+/// Points, not lists of queries within reach, go into cells a little wider than the radius:
+/// queries and candidates are the same points, so no cell turns a candidate away, and each point
+/// lies in one cell only. The points are sorted by cell (z, y, x), and the points of a cell
+/// measure the runs of the 27 cells around it, found once for them all: by a dense table of
+/// every cell's first point, where the points' box holds at most kDenseCellsPerPoint cells a
+/// point (9 runs of 3 cells each), else by a hash table of the occupied cells, so that the cells
+/// stay of the radius however far apart the points lie (two tanks, a particle flung far away).
 std::vector<double> kthAmongPoints(std::span<const glm::vec3> points, double radius) {
   const std::size_t n = points.size();
   std::vector<double> kth(n, std::numeric_limits<double>::infinity());
-  if (n <= kNeighbours || !(radius > 0)) return kth;
+  if (n <= kNeighbours || !(radius > 0) || !std::isfinite(radius)) return kth;
   glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
   for (const glm::vec3& p : points) {
     lo = glm::min(lo, glm::dvec3(p));
@@ -499,55 +591,91 @@ std::vector<double> kthAmongPoints(std::span<const glm::vec3> points, double rad
   }
   const glm::dvec3 extent = hi - lo;
   if (!std::isfinite(extent.x + extent.y + extent.z)) return kth;
-  // A neighbour within the radius (its float distance, rounded by up to 3e-7 relative) lies in
-  // a cell next to the query's when the cells are a little wider than the radius; a coordinate
-  // in cells (at most kCellsPerPoint * n of them) is exact to far below that margin.
-  constexpr double kCellsPerPoint = 4;
-  double cell = radius * (1 + 1e-5);
-  const auto cellsFor = [&](double c) { return glm::floor(extent / c) + 3.0; };  // a cell of margin each side
-  glm::dvec3 dims = cellsFor(cell);
-  const double maxCells = std::max(4096.0, kCellsPerPoint * double(n));
-  while (!(dims.x * dims.y * dims.z <= maxCells)) {
-    cell *= std::max(1.01, std::cbrt(dims.x * dims.y * dims.z / maxCells) * 1.01);
-    dims = cellsFor(cell);
-  }
-  const std::size_t dx = std::size_t(dims.x), dxy = dx * std::size_t(dims.y);
+  // A candidate is counted when its float squared distance d2 is at most float(radius^2): its
+  // true distance exceeds the radius by at most 3e-7 of it, plus subnormalMargin. Cells wider
+  // than that put it in a cell next to the query's; a coordinate in cells (below 2^20, found in
+  // doubles) is exact to far below the margin. Coarser cells where the spread is over 2^20 radii.
+  constexpr double kAxisCells = double((1 << 20) - 3);
+  const double cell =
+      std::max(radius * (1 + 1e-5) + subnormalMargin(radius), std::max({extent.x, extent.y, extent.z}) / kAxisCells);
+  // Cell coordinates from 1 with a cell of margin each side: the cells around one are in range.
+  const glm::dvec3 axisCells = glm::floor(extent / cell) + 3.0;
+  constexpr double kDenseCellsPerPoint = 8;
+  const bool dense = axisCells.x * axisCells.y * axisCells.z <= std::max(4096.0, kDenseCellsPerPoint * double(n));
+  const std::uint64_t rowCells = dense ? std::uint64_t(axisCells.x) : std::uint64_t(1) << 21;
+  const std::uint64_t sliceCells = rowCells * (dense ? std::uint64_t(axisCells.y) : std::uint64_t(1) << 21);
   const auto cellOf = [&](const glm::vec3& p) {
-    const glm::dvec3 c = glm::floor((glm::dvec3(p) - lo) / cell) + 1.0;
-    return std::size_t(c.z) * dxy + std::size_t(c.y) * dx + std::size_t(c.x);
+    const glm::u64vec3 c(glm::floor((glm::dvec3(p) - lo) / cell) + 1.0);
+    return c.z * sliceCells + c.y * rowCells + c.x;
   };
-  std::vector<std::uint32_t> start(std::size_t(dims.x * dims.y * dims.z) + 1, 0);
-  std::vector<std::uint32_t> cells(n);
-  for (std::size_t i = 0; i < n; ++i) ++start[(cells[i] = std::uint32_t(cellOf(points[i]))) + 1];
-  for (std::size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
-  std::vector<glm::vec3> sorted(n);
-  std::vector<std::uint32_t> original(n);
-  {
-    std::vector<std::uint32_t> next(start.begin(), start.end() - 1);
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::uint32_t k = next[cells[i]]++;
-      sorted[k] = points[i];
-      original[k] = std::uint32_t(i);
+  // The points by cell: a counting sort where dense, whose counts become each cell's first point.
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> order(n);  // (cell, point)
+  std::vector<std::uint32_t> firstPoint;                          // dense: at or after each cell, then n
+  if (dense) {
+    firstPoint.assign(std::size_t(sliceCells * std::uint64_t(axisCells.z)) + 1, 0);
+    std::vector<std::uint64_t> cells(n);
+    for (std::size_t i = 0; i < n; ++i) ++firstPoint[(cells[i] = cellOf(points[i])) + 1];
+    for (std::size_t c = 1; c < firstPoint.size(); ++c) firstPoint[c] += firstPoint[c - 1];
+    std::vector<std::uint32_t> next(firstPoint.begin(), firstPoint.end() - 1);
+    for (std::size_t i = 0; i < n; ++i) order[next[cells[i]]++] = {cells[i], std::uint32_t(i)};
+  } else {
+    for (std::size_t i = 0; i < n; ++i) order[i] = {cellOf(points[i]), std::uint32_t(i)};
+    std::sort(order.begin(), order.end());
+  }
+  std::vector<glm::vec3> sorted(n);  // the points in the order of their cells
+  std::vector<std::uint64_t> runCell;
+  std::vector<std::uint32_t> runStart;  // each occupied cell's first point, then n
+  for (std::size_t k = 0; k < n; ++k) {
+    sorted[k] = points[order[k].second];
+    if (k == 0 || order[k].first != order[k - 1].first) {
+      runCell.push_back(order[k].first);
+      runStart.push_back(std::uint32_t(k));
     }
   }
+  runStart.push_back(std::uint32_t(n));
+  // Sparse: open addressing, at most half full, each slot a run + 1 or 0.
+  const std::size_t slots = dense ? 0 : std::bit_ceil(2 * runCell.size());
+  const int shift = dense ? 0 : 64 - std::countr_zero(slots);
+  const auto slotOf = [&](std::uint64_t c) { return std::size_t((c * 0x9e3779b97f4a7c15ull) >> shift); };
+  std::vector<std::uint32_t> table(slots, 0);
+  for (std::size_t r = 0; r < (dense ? 0 : runCell.size()); ++r) {
+    std::size_t s = slotOf(runCell[r]);
+    while (table[s]) s = (s + 1) & (slots - 1);
+    table[s] = std::uint32_t(r + 1);
+  }
   const float radius2 = float(radius * radius);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& range) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, runCell.size(), 256), [&](const auto& range) {
     std::vector<float> near;
-    for (std::size_t k = range.begin(); k != range.end(); ++k) {
-      near.clear();
-      const glm::vec3 q = sorted[k];
-      const std::size_t c = cells[original[k]];
-      for (std::size_t row :
-           {c - dxy - dx, c - dxy, c - dxy + dx, c - dx, c, c + dx, c + dxy - dx, c + dxy, c + dxy + dx})
-        for (std::size_t j = start[row - 1]; j < start[row + 2]; ++j) {
-          const glm::vec3 d = q - sorted[j];
-          const float d2 = d.x * d.x + d.y * d.y + d.z * d.z;
-          if (d2 <= radius2 && j != k) near.push_back(d2);
+    std::array<std::pair<std::uint32_t, std::uint32_t>, 27> around;  // runs of points to measure
+    for (std::size_t r = range.begin(); r != range.end(); ++r) {
+      std::size_t runs = 0;
+      for (const std::uint64_t slice : {runCell[r] - sliceCells, runCell[r], runCell[r] + sliceCells})
+        for (const std::uint64_t row : {slice - rowCells, slice, slice + rowCells}) {
+          if (dense) {
+            around[runs++] = {firstPoint[row - 1], firstPoint[row + 2]};
+            continue;
+          }
+          for (std::uint64_t c = row - 1; c <= row + 1; ++c)
+            for (std::size_t s = slotOf(c); table[s]; s = (s + 1) & (slots - 1))
+              if (runCell[table[s] - 1] == c) {
+                around[runs++] = {runStart[table[s] - 1], runStart[table[s]]};
+                break;
+              }
         }
-      if (near.size() < kNeighbours) continue;
-      std::nth_element(near.begin(), near.begin() + (kNeighbours - 1), near.end());
-      const double d2 = near[kNeighbours - 1];
-      if (d2 <= radius * radius) kth[original[k]] = std::sqrt(d2);
+      for (std::size_t k = runStart[r]; k < runStart[r + 1]; ++k) {
+        near.clear();
+        const glm::vec3 q = sorted[k];
+        for (std::size_t a = 0; a < runs; ++a)
+          for (std::size_t j = around[a].first; j < around[a].second; ++j) {
+            const glm::vec3 d = q - sorted[j];
+            const float d2 = d.x * d.x + d.y * d.y + d.z * d.z;
+            if (d2 <= radius2 && j != k) near.push_back(d2);
+          }
+        if (near.size() < kNeighbours) continue;
+        std::nth_element(near.begin(), near.begin() + (kNeighbours - 1), near.end());
+        const double d2 = near[kNeighbours - 1];
+        if (d2 <= radius * radius) kth[order[k].second] = std::sqrt(d2);
+      }
     }
   });
   return kth;

@@ -25,9 +25,12 @@
 // Cost of the neighbour estimate: one read of the source when it has at most kSpacingSample
 // particles or seeks to a particle (raw, binary PLY: the sample costs kSpacingSample small
 // reads, asked of the disk all at once), else two (rarely more); memory O(kSpacingSample) plus one chunk of particles,
-// plus at most about 20 MiB, whatever the frame's size, for the search's cells near the sample (about 5 MiB for the
+// plus at most about 25 MiB, whatever the frame's size, for the search's cells near the sample (about 5 MiB for the
 // 20 M particle synth frame): at most 4 MiB of bits and 2 MiB of their ranks and, per cell within the search radius of
-// a sampled particle (at most 64 each), the list of those particles. The source is rewound afterwards.
+// a sampled particle (at most 64 each), the list of those particles; where the sample lies far apart (two tanks, a
+// particle flung far away), instead of the ranks, up to 20 MiB of (cell, particle) pairs while the lists of cells of
+// the radius are made. The time stays about that of a read of the frame however far apart its particles lie. The
+// source is rewound afterwards.
 #pragma once
 
 #include <cstddef>
@@ -77,7 +80,7 @@ std::vector<double> kthNeighbourDistances(std::span<const glm::vec3> queries, st
                                           std::span<const glm::vec3> candidates, double radius);
 /// The search among the sample itself (queries and candidates the same points, a point not its
 /// own neighbour): kthNeighbourDistances(points, 0..n-1, points, radius), found without lists of
-/// queries by cell. The thinned starts of the estimate's radius run it.
+/// queries by cell. Every try of the estimate's median within its sample runs it.
 std::vector<double> kthNeighbourDistancesAmong(std::span<const glm::vec3> points, double radius);
 }  // namespace detail
 

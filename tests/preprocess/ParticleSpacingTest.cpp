@@ -9,6 +9,7 @@
 #include <limits>
 #include <numeric>
 #include <random>
+#include <span>
 
 #include <glm/common.hpp>
 
@@ -34,6 +35,28 @@ std::vector<glm::vec3> lattice(int n, float spacing, float jitter, glm::vec3 ori
         points.push_back(origin + spacing * glm::vec3(x + jitter * u(rng), y + jitter * u(rng), z + jitter * u(rng)));
   std::shuffle(points.begin(), points.end(), rng);
   return points;
+}
+
+/// Each query's 12th smallest float squared distance to a candidate that is not itself (by id),
+/// by comparing every pair (the search's float arithmetic).
+std::vector<float> kthSquaredByEveryPair(std::span<const glm::vec3> queries, std::span<const std::uint64_t> ids,
+                                         std::span<const glm::vec3> candidates) {
+  std::vector<float> kth2;
+  std::vector<float> d2(candidates.size());
+  for (std::size_t q = 0; q < queries.size(); ++q) {
+    for (std::size_t c = 0; c < candidates.size(); ++c) {
+      const glm::vec3 d = queries[q] - candidates[c];
+      d2[c] = c == ids[q] ? std::numeric_limits<float>::infinity() : d.x * d.x + d.y * d.y + d.z * d.z;
+    }
+    std::nth_element(d2.begin(), d2.begin() + (kSpacingNeighbour - 1), d2.end());
+    kth2.push_back(d2[kSpacingNeighbour - 1]);
+  }
+  return kth2;
+}
+
+/// What the search must give a query whose 12th squared distance is kth2, at `radius`.
+double expectedKth(float kth2, double radius) {
+  return double(kth2) <= radius * radius ? std::sqrt(double(kth2)) : std::numeric_limits<double>::infinity();
 }
 
 TEST(ParticleSpacing, RegularLatticeGivesItsSpacing) {
@@ -89,16 +112,7 @@ TEST(ParticleSpacing, TheSearchFindsTheKthNeighboursOfComparingEveryPair) {
     ids.push_back(candidates.size() + std::size_t(i));
   }
 
-  std::vector<float> kth2;  // each query's 12th smallest squared distance
-  std::vector<float> d2(candidates.size());
-  for (std::size_t q = 0; q < queries.size(); ++q) {
-    for (std::size_t c = 0; c < candidates.size(); ++c) {
-      const glm::vec3 d = queries[q] - candidates[c];
-      d2[c] = c == ids[q] ? std::numeric_limits<float>::infinity() : d.x * d.x + d.y * d.y + d.z * d.z;
-    }
-    std::nth_element(d2.begin(), d2.begin() + (kSpacingNeighbour - 1), d2.end());
-    kth2.push_back(d2[kSpacingNeighbour - 1]);
-  }
+  const std::vector<float> kth2 = kthSquaredByEveryPair(queries, ids, candidates);
   std::vector<float> sorted = kth2;
   std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(sorted.size() / 2), sorted.end());
   const double median = std::sqrt(double(sorted[sorted.size() / 2]));
@@ -108,13 +122,42 @@ TEST(ParticleSpacing, TheSearchFindsTheKthNeighboursOfComparingEveryPair) {
     ASSERT_EQ(found.size(), queries.size());
     std::size_t within = 0;
     for (std::size_t q = 0; q < queries.size(); ++q) {
-      const double expected =
-          double(kth2[q]) <= radius * radius ? std::sqrt(double(kth2[q])) : std::numeric_limits<double>::infinity();
+      const double expected = expectedKth(kth2[q], radius);
       within += std::isfinite(expected);
       ASSERT_EQ(found[q], expected) << "query " << q << " at radius " << radius;
     }
     EXPECT_GT(within, 0u);
     EXPECT_LT(within, queries.size()) << "some queries' 12th neighbour lies beyond the radius";
+  }
+}
+
+TEST(ParticleSpacing, TheSearchOfQueriesFarApartKeepsCellsOfTheRadius) {
+  // Two lattices 10^4 apart (two tanks), and one query flung between them: a grid of cells of the
+  // radius over the queries' box would be too large, and the bits' cells are coarser than two
+  // radii, so the lists are of cells of the radius again, hashed (buildFineLists). Each query's
+  // 12th-neighbour distance must still be the one of comparing every pair.
+  std::vector<glm::vec3> candidates = lattice(12, 0.25f, 0.0f, glm::vec3(0.0f));
+  const std::vector<glm::vec3> far = lattice(12, 0.25f, 0.6f, glm::vec3(1.0e4f, 0.0f, 5.0e3f), 9);
+  candidates.insert(candidates.end(), far.begin(), far.end());
+  std::vector<glm::vec3> queries;
+  std::vector<std::uint64_t> ids;
+  for (std::size_t i = 0; i < candidates.size(); i += 7) {
+    queries.push_back(candidates[i]);
+    ids.push_back(i);
+  }
+  queries.push_back(glm::vec3(4.0e3f));
+  ids.push_back(candidates.size());
+  const std::vector<float> kth2 = kthSquaredByEveryPair(queries, ids, candidates);
+  // The 12th neighbour on the lattice is sqrt(2) spacings away: none within 0.3, on the cells'
+  // faces at sqrt(2) / 4 (the plain lattice), most within 0.4.
+  for (const double radius : {0.3, std::sqrt(2.0) * 0.25, 0.4}) {
+    const std::vector<double> found = detail::kthNeighbourDistances(queries, ids, candidates, radius);
+    std::size_t within = 0;
+    for (std::size_t q = 0; q < queries.size(); ++q) {
+      within += std::isfinite(found[q]);
+      ASSERT_EQ(found[q], expectedKth(kth2[q], radius)) << "query " << q << " at radius " << radius;
+    }
+    if (radius == 0.4) EXPECT_GT(within, queries.size() / 2);
   }
 }
 
@@ -165,6 +208,34 @@ TEST(ParticleSpacing, TheSearchAmongTheSampleFindsWhatTheSearchOfQueriesFinds) {
   }
   const std::vector<double> grouped = detail::kthNeighbourDistancesAmong(groups, 0.25);
   for (std::size_t i = 0; i < groups.size(); ++i) ASSERT_EQ(grouped[i], 0.25) << "point " << i;
+  // The same with one point flung far away, so that the cells of the radius are too many to keep
+  // a table of (the occupied ones are hashed instead), in both searches.
+  std::vector<glm::vec3> flung = groups;
+  flung.push_back(glm::vec3(1.0e4f));
+  const std::vector<double> far = detail::kthNeighbourDistancesAmong(flung, 0.25);
+  for (std::size_t i = 0; i < groups.size(); ++i) ASSERT_EQ(far[i], 0.25) << "point " << i << ", one flung far";
+  EXPECT_EQ(far.back(), std::numeric_limits<double>::infinity());
+  std::vector<std::uint64_t> flungIds(flung.size());
+  std::iota(flungIds.begin(), flungIds.end(), 0);
+  const std::vector<double> farOfQueries = detail::kthNeighbourDistances(flung, flungIds, flung, 0.25);
+  for (std::size_t i = 0; i < flung.size(); ++i)
+    ASSERT_EQ(farOfQueries[i], far[i]) << "point " << i << ", one flung far, the search of queries";
+  // Scaled by 2^-70 the squared distances are subnormal floats, rounded to 3 % of them: groups
+  // whose 13th point lies 0.4 % beyond the radius still count it, as the search of queries does,
+  // though from just below a cell face it lies two cells of the radius on.
+  std::vector<glm::vec3> tiny;
+  for (int i = 0; i <= 4096; ++i) {
+    const glm::vec3 base(float(i) / 16384.0f, 0.75f * float(i), 0.0f);
+    for (int c = 0; c < kSpacingNeighbour; ++c) tiny.push_back(std::ldexp(1.0f, -70) * base);
+    tiny.push_back(std::ldexp(1.0f, -70) * (base + glm::vec3(0.25f + 0x1p-10f, 0.0f, 0.0f)));
+  }
+  std::vector<std::uint64_t> tinyIds(tiny.size());
+  std::iota(tinyIds.begin(), tinyIds.end(), 0);
+  const double tinyRadius = std::ldexp(0.25, -70);
+  const std::vector<double> tinyExpected = detail::kthNeighbourDistances(tiny, tinyIds, tiny, tinyRadius);
+  ASSERT_TRUE(std::isfinite(tinyExpected.front())) << "the 13th point counts";
+  const std::vector<double> tinyFound = detail::kthNeighbourDistancesAmong(tiny, tinyRadius);
+  for (std::size_t i = 0; i < tiny.size(); ++i) ASSERT_EQ(tinyFound[i], tinyExpected[i]) << "point " << i << ", scaled";
   EXPECT_EQ(detail::kthNeighbourDistancesAmong(std::span(points).first(kSpacingNeighbour), 40.0),
             std::vector<double>(kSpacingNeighbour, std::numeric_limits<double>::infinity()))
       << "12 points have 11 neighbours each";
