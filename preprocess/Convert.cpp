@@ -629,6 +629,27 @@ StoredAttribute chooseAttribute(const std::optional<std::string>& asked, const s
   throw FileError(lacking->files.front(), "has no attribute '" + *asked + "'");
 }
 
+/// For a domain too long for one cell per particle spacing: where the particles the spacing
+/// estimate sampled lie in a box that is not (the rest, a few flung far away, unsampled), that
+/// box grown by a tenth each side, as the --domain to give; else nothing.
+std::string sampledDomainHint(const SpacingEstimate& spacing) {
+  if (!spacing.sampledBounds || spacing.sampledBounds->isEmpty() || !spacing.known()) return {};
+  const Box& sampled = *spacing.sampledBounds;
+  const glm::dvec3 margin = glm::max(sampled.extent() * 0.1, glm::dvec3(2 * spacing.spacing));
+  // Rounded out to a hundredth of the longest side's power of ten, to read and type.
+  const glm::dvec3 grown = sampled.extent() + 2.0 * margin;
+  const double step = std::pow(10.0, std::floor(std::log10(std::max({grown.x, grown.y, grown.z}) / 100)));
+  const Box domain{glm::floor((sampled.min - margin) / step) * step, glm::ceil((sampled.max + margin) / step) * step};
+  const glm::dvec3 extent = domain.extent();
+  if (std::floor(std::max({extent.x, extent.y, extent.z}) / spacing.spacing) + 1 > kMaxCellsPerAxis) return {};
+  std::string box;
+  for (const double v : {domain.min.x, domain.min.y, domain.min.z, domain.max.x, domain.max.y, domain.max.z})
+    box += (box.empty() ? "" : ",") + numberText(v);
+  return ". The particles sampled for the spacing all lie within --domain " + box +
+         " (their box grown by a tenth): given that, convert renders them at one cell per particle spacing " +
+         "and leaves out the particles beyond it";
+}
+
 /// The header of a new store: the cell size as ConvertOptions documents it.
 StoreHeader chooseHeader(const Box& bounds, const ConvertOptions& options, const StoredAttribute& attribute,
                          const SpacingEstimate& spacing, ConvertReport& report) {
@@ -656,7 +677,7 @@ StoreHeader chooseHeader(const Box& bounds, const ConvertOptions& options, const
     }
     report.warnings.push_back("one cell per particle spacing (" + numberText(spacing.spacing) +
                               ") would make the domain " + numberText(cells) + " cells long, more than " +
-                              std::to_string(kMaxCellsPerAxis) + fallback);
+                              std::to_string(kMaxCellsPerAxis) + fallback + sampledDomainHint(spacing));
   } else {
     report.warnings.push_back("the particle spacing is unknown (" + spacing.origin + ")" + fallback);
   }

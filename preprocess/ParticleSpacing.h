@@ -56,6 +56,9 @@ struct SpacingEstimate {
   /// The bounds of the source's finite particles when the estimate read every particle (the
   /// neighbour estimate's sampling pass), so that convert need not read them again; else nullopt.
   std::optional<Box> bounds;
+  /// The box of the particles the neighbour estimate sampled, where it sampled fewer than all:
+  /// where most of them lie (a particle flung far away is seldom among them); else nullopt.
+  std::optional<Box> sampledBounds;
   bool known() const { return spacing > 0; }
 };
 

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <sstream>
 #include <tuple>
 
 #include <tbb/task_arena.h>
@@ -416,6 +417,42 @@ TEST(ConvertSpacing, AStoreConvertedIntoAgainKeepsItsCellsAndRefusesOthersByNumb
         << e.what();
   }
   EXPECT_EQ(BrickStore::open(temp / "s").frames(), (std::vector<int>{0, 1, 2}));
+}
+
+TEST(ConvertSpacing, AParticleFlungFarIsLeftOutByTheDomainTheWarningNames) {
+  // 125000 particles in a box of 0.05 and one 10^6 spacings away: one cell per spacing does not
+  // fit, and the warning names the box of the particles the estimate sampled (the far one seldom
+  // among them; the sample is drawn with a fixed seed) as the --domain to give. With it, the
+  // store has one cell per spacing and leaves out the far particle alone.
+  testing::TempDir temp("spacing-flung");
+  auto points = latticePoints(50, 1e-3f);
+  points.push_back({1000, 0, 0});
+  const fs::path raw = temp / "flung.bin";
+  writeRaw(raw, points);
+  const ConvertReport report = convert({{0, {raw}}}, temp / "store", silent());
+  ASSERT_EQ(report.warnings.size(), 1u);
+  const std::string& warning = report.warnings[0];
+  const std::size_t at = warning.find("--domain ");
+  ASSERT_NE(at, std::string::npos) << warning;
+  std::istringstream box(warning.substr(at + 9));
+  Box domain;
+  char comma = 0;
+  box >> domain.min.x >> comma >> domain.min.y >> comma >> domain.min.z >> comma >> domain.max.x >> comma >>
+      domain.max.y >> comma >> domain.max.z;
+  ASSERT_FALSE(box.fail()) << warning;
+  EXPECT_TRUE(domain.contains(glm::dvec3(0)) && domain.contains(glm::dvec3(0.049))) << warning;
+  EXPECT_FALSE(domain.contains(glm::dvec3(1000, 0, 0))) << warning;
+  EXPECT_LT(domain.extent().x, 0.1) << warning;
+
+  ConvertOptions options = silent();
+  options.domain = domain;
+  const ConvertReport within = convert({{0, {raw}}}, temp / "within", options);
+  EXPECT_TRUE(within.warnings.empty()) << within.warnings.front();
+  EXPECT_EQ(within.cellSizeOrigin, "one cell per particle spacing");
+  EXPECT_EQ(within.header.cellSize, within.header.particleSpacing);
+  ASSERT_EQ(within.frames.size(), 1u);
+  EXPECT_EQ(within.frames[0].stats.particles, points.size() - 1);
+  EXPECT_EQ(within.frames[0].stats.skippedOutside, 1u);
 }
 
 TEST(ConvertSpacing, SpacingThatOverflowsTheGridFallsBackToTheDefaultResolution) {

@@ -157,7 +157,9 @@ TEST(ParticleSpacing, TheSearchOfQueriesFarApartKeepsCellsOfTheRadius) {
       within += std::isfinite(found[q]);
       ASSERT_EQ(found[q], expectedKth(kth2[q], radius)) << "query " << q << " at radius " << radius;
     }
-    if (radius == 0.4) EXPECT_GT(within, queries.size() / 2);
+    if (radius == 0.4) {
+      EXPECT_GT(within, queries.size() / 2);
+    }
   }
 }
 
