@@ -664,8 +664,6 @@ StoreHeader chooseHeader(const Box& bounds, const ConvertOptions& options, const
     report.cellSizeOrigin = std::to_string(*options.resolution) + " cells along the longest axis";
     return makeStoreHeader(bounds, o, attribute.kind, attribute.name);
   }
-  const std::string fallback =
-      "; using " + std::to_string(kDefaultResolution) + " cells along the longest axis instead";
   if (spacing.known()) {
     const glm::dvec3 extent = bounds.isEmpty() ? glm::dvec3(0) : bounds.extent();
     const double longest = std::max({extent.x, extent.y, extent.z});
@@ -675,12 +673,21 @@ StoreHeader chooseHeader(const Box& bounds, const ConvertOptions& options, const
       report.cellSizeOrigin = "one cell per particle spacing";
       return makeStoreHeader(bounds, o, attribute.kind, attribute.name);
     }
+    // The finest grid a store holds, the nearest to one cell per spacing (longest / resolution
+    // puts the far corner in cell resolution + 1).
+    o.resolution = kMaxCellsPerAxis - 1;
     report.warnings.push_back("one cell per particle spacing (" + numberText(spacing.spacing) +
                               ") would make the domain " + numberText(cells) + " cells long, more than " +
-                              std::to_string(kMaxCellsPerAxis) + fallback + sampledDomainHint(spacing));
-  } else {
-    report.warnings.push_back("the particle spacing is unknown (" + spacing.origin + ")" + fallback);
+                              std::to_string(kMaxCellsPerAxis) + "; using " + std::to_string(*o.resolution) +
+                              " cells along the longest axis instead, the most a store holds (" +
+                              numberText(longest / *o.resolution / spacing.spacing) + " particle spacings a cell)" +
+                              sampledDomainHint(spacing));
+    report.cellSizeOrigin =
+        std::to_string(*o.resolution) + " cells along the longest axis (the most; one per spacing would not fit)";
+    return makeStoreHeader(bounds, o, attribute.kind, attribute.name);
   }
+  report.warnings.push_back("the particle spacing is unknown (" + spacing.origin + "); using " +
+                            std::to_string(kDefaultResolution) + " cells along the longest axis instead");
   o.resolution = kDefaultResolution;
   report.cellSizeOrigin = std::to_string(kDefaultResolution) + " cells along the longest axis (default)";
   return makeStoreHeader(bounds, o, attribute.kind, attribute.name);

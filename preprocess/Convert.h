@@ -21,9 +21,10 @@
 // liquid (Mantaflow's FLIP file beside its secondary particles).
 //
 // Cell size: --cell-size, else longest domain axis / --resolution, else (neither given) one cell
-// per particle spacing of the first frame (ParticleSpacing.h), falling back to
-// kDefaultResolution cells along the longest axis, with a warning, when the spacing is unknown
-// or the grid would exceed kMaxCellsPerAxis. The spacing (ConvertOptions::particleSpacing, else
+// per particle spacing of the first frame (ParticleSpacing.h), falling back, with a warning, to
+// kDefaultResolution cells along the longest axis when the spacing is unknown, and to the most a
+// store holds (kMaxCellsPerAxis - 1 cells along it) when one per spacing would exceed
+// kMaxCellsPerAxis. The spacing (ConvertOptions::particleSpacing, else
 // measured) is recorded in the store header either way (StoreHeader::particleSpacing).
 //
 // Concurrent writers: any number of convert() calls, in any processes and on any machines of a
@@ -137,7 +138,7 @@ struct ConvertReport {
   /// Where header.upAxis came from ("--up", the file that states it, "the existing store"),
   /// or why it is unknown.
   std::string upAxisOrigin;
-  /// Worth telling the user (e.g. the fallback from the particle spacing to kDefaultResolution).
+  /// Worth telling the user (e.g. a fallback from one cell per particle spacing).
   std::vector<std::string> warnings;
 };
 

@@ -455,7 +455,7 @@ TEST(ConvertSpacing, AParticleFlungFarIsLeftOutByTheDomainTheWarningNames) {
   EXPECT_EQ(within.frames[0].stats.skippedOutside, 1u);
 }
 
-TEST(ConvertSpacing, SpacingThatOverflowsTheGridFallsBackToTheDefaultResolution) {
+TEST(ConvertSpacing, SpacingThatOverflowsTheGridFallsBackToTheFinestGridOrUnknownToTheDefault) {
   testing::TempDir temp("spacing-fallback");
   auto points = latticePoints(16, 1e-4f);
   points.push_back({20, 0, 0});  // 200000 spacings away
@@ -464,8 +464,13 @@ TEST(ConvertSpacing, SpacingThatOverflowsTheGridFallsBackToTheDefaultResolution)
   const ConvertReport report = convert({{0, {raw}}}, temp / "store", silent());
   ASSERT_EQ(report.warnings.size(), 1u);
   EXPECT_NE(report.warnings[0].find("more than 65536"), std::string::npos) << report.warnings[0];
-  EXPECT_NE(report.warnings[0].find("1024 cells"), std::string::npos) << report.warnings[0];
-  EXPECT_DOUBLE_EQ(report.header.cellSize, 20.0 / kDefaultResolution);
+  EXPECT_NE(report.warnings[0].find("using 65535 cells along the longest axis"), std::string::npos)
+      << report.warnings[0];
+  EXPECT_DOUBLE_EQ(report.header.cellSize, 20.0 / (kMaxCellsPerAxis - 1));
+  EXPECT_EQ(std::uint64_t(report.header.brickGrid.x) * report.header.brickSize, kMaxCellsPerAxis)
+      << "the finest grid a store holds, the far particle in its last cell";
+  ASSERT_EQ(report.frames.size(), 1u);
+  EXPECT_EQ(report.frames[0].stats.particles, points.size()) << "none outside";
   EXPECT_NEAR(report.header.particleSpacing, 1e-4, 5e-6);  // still recorded
 
   // Too few particles to measure: the same fallback, the spacing unknown.
