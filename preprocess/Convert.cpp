@@ -629,6 +629,9 @@ StoredAttribute chooseAttribute(const std::optional<std::string>& asked, const s
   throw FileError(lacking->files.front(), "has no attribute '" + *asked + "'");
 }
 
+/// The cells of `cellSize` that span `length` from its start: the far end lands in the last one.
+double cellsAlong(double length, double cellSize) { return std::floor(length / cellSize) + 1; }
+
 /// For a domain too long for one cell per particle spacing: where the particles the spacing
 /// estimate sampled lie in a box that is not (the rest, a few flung far away, unsampled), that
 /// box grown by a tenth each side, as the --domain to give; else nothing.
@@ -641,7 +644,7 @@ std::string sampledDomainHint(const SpacingEstimate& spacing) {
   const double step = std::pow(10.0, std::floor(std::log10(std::max({grown.x, grown.y, grown.z}) / 100)));
   const Box domain{glm::floor((sampled.min - margin) / step) * step, glm::ceil((sampled.max + margin) / step) * step};
   const glm::dvec3 extent = domain.extent();
-  if (std::floor(std::max({extent.x, extent.y, extent.z}) / spacing.spacing) + 1 > kMaxCellsPerAxis) return {};
+  if (cellsAlong(std::max({extent.x, extent.y, extent.z}), spacing.spacing) > kMaxCellsPerAxis) return {};
   std::string box;
   for (const double v : {domain.min.x, domain.min.y, domain.min.z, domain.max.x, domain.max.y, domain.max.z})
     box += (box.empty() ? "" : ",") + numberText(v);
@@ -667,7 +670,7 @@ StoreHeader chooseHeader(const Box& bounds, const ConvertOptions& options, const
   if (spacing.known()) {
     const glm::dvec3 extent = bounds.isEmpty() ? glm::dvec3(0) : bounds.extent();
     const double longest = std::max({extent.x, extent.y, extent.z});
-    const double cells = std::floor(longest / spacing.spacing) + 1;
+    const double cells = cellsAlong(longest, spacing.spacing);
     if (cells <= kMaxCellsPerAxis) {
       o.cellSize = spacing.spacing;
       report.cellSizeOrigin = "one cell per particle spacing";
@@ -874,7 +877,7 @@ StoreHeader makeStoreHeader(const Box& bounds, const ConvertOptions& options, At
     if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
       throw InputError("--attribute: the attribute name has a control character");
   for (int a = 0; a < 3; ++a) {
-    const double cells = std::floor(extent[a] / cellSize) + 1;  // the max corner lands in the last cell
+    const double cells = cellsAlong(extent[a], cellSize);
     if (cells > kMaxCellsPerAxis)
       throw InputError("the domain is " + std::to_string(std::uint64_t(cells)) + " cells long on axis " + "xyz"[a] +
                        ", more than " + std::to_string(kMaxCellsPerAxis) + "; use a larger --cell-size");

@@ -163,6 +163,55 @@ std::optional<Sample> sampleByNumber(ParticleSource& source, std::size_t size) {
   return s;
 }
 
+/// The key of cell (x, y, z) of a sparse grid, 21 bits an axis (x fastest).
+std::uint64_t cellKey(std::uint64_t x, std::uint64_t y, std::uint64_t z) { return (z << 42) | (y << 21) | x; }
+
+/// (cell, item) pairs sorted by cell, as runs: each occupied cell's key and first pair; with
+/// `hashed`, an open-addressing table (at most half full) from a cell to its run, for grids of
+/// more cells than a table of every one could hold. The searches' sparse cells
+/// (KthNeighbours::buildFineLists, kthAmongPoints).
+class CellRuns {
+ public:
+  CellRuns() = default;
+  CellRuns(std::span<const std::pair<std::uint64_t, std::uint32_t>> sorted, bool hashed) {
+    for (std::size_t i = 0; i < sorted.size(); ++i)
+      if (i == 0 || sorted[i].first != sorted[i - 1].first) {
+        mCells.push_back(sorted[i].first);
+        mStarts.push_back(std::uint32_t(i));
+      }
+    mStarts.push_back(std::uint32_t(sorted.size()));
+    if (!hashed) return;
+    const std::size_t slots = std::bit_ceil(std::max<std::size_t>(2, 2 * mCells.size()));
+    mShift = 64 - std::countr_zero(slots);
+    mTable.assign(slots, 0);
+    for (std::size_t run = 0; run < mCells.size(); ++run) {
+      std::size_t s = slotOf(mCells[run]);
+      while (mTable[s]) s = (s + 1) & (slots - 1);
+      mTable[s] = std::uint32_t(run + 1);
+    }
+  }
+
+  std::size_t size() const { return mCells.size(); }
+  std::uint64_t cell(std::size_t run) const { return mCells[run]; }
+  /// The pairs [first, end) of a run.
+  std::uint32_t first(std::size_t run) const { return mStarts[run]; }
+  std::uint32_t end(std::size_t run) const { return mStarts[run + 1]; }
+  /// The run of `cell`, or -1 where it holds none (a hashed CellRuns only).
+  std::int64_t find(std::uint64_t cell) const {
+    for (std::size_t s = slotOf(cell); mTable[s]; s = (s + 1) & (mTable.size() - 1))
+      if (mCells[mTable[s] - 1] == cell) return std::int64_t(mTable[s] - 1);
+    return -1;
+  }
+
+ private:
+  std::size_t slotOf(std::uint64_t cell) const { return std::size_t((cell * 0x9e3779b97f4a7c15ull) >> mShift); }
+
+  std::vector<std::uint64_t> mCells;
+  std::vector<std::uint32_t> mStarts;  ///< each run's first pair, then the number of pairs
+  std::vector<std::uint32_t> mTable;   ///< a run + 1, or 0
+  int mShift = 64;
+};
+
 /// The k-th neighbour distance of every query among the candidates given to add(), searched as
 /// far as `radius`: a query whose k-th neighbour is farther keeps +inf. A grid of cells of the
 /// radius (coarser where that would exceed kMaxSearchCells, or kMaxAxisCells along an axis)
@@ -199,10 +248,6 @@ class KthNeighbours {
   /// Candidates with consecutive ids from `firstId` (the source's order).
   void add(std::span<const glm::vec3> candidates, std::uint64_t firstId) {
     addAll(candidates, [&](std::size_t i) { return firstId + i; });
-  }
-  /// Candidates with the given ids.
-  void add(std::span<const glm::vec3> candidates, std::span<const std::uint64_t> ids) {
-    addAll(candidates, [&](std::size_t i) { return ids[i]; });
   }
 
   /// add(), for candidates read on several threads at once: a thread's hits are merged into the
@@ -375,42 +420,19 @@ class KthNeighbours {
     std::vector<std::pair<std::uint64_t, std::uint32_t>> pairs;  // (fine cell, query)
     for (const auto& entry : order)
       forEachCellNear(mFine, mQueries.positions[entry.second], reach, [&](int x, int y, int z) {
-        pairs.push_back({fineKey(x, y, z), entry.second});
+        pairs.push_back({cellKey(std::uint64_t(x), std::uint64_t(y), std::uint64_t(z)), entry.second});
       });
     std::sort(pairs.begin(), pairs.end());
+    mFineLists = CellRuns(pairs, true);
     mListed.resize(pairs.size());
-    mListStart.clear();
-    for (std::size_t i = 0; i < pairs.size(); ++i) {
-      if (i == 0 || pairs[i].first != pairs[i - 1].first) {
-        mFineKeys.push_back(pairs[i].first);
-        mListStart.push_back(std::uint32_t(i));
-      }
-      mListed[i] = pairs[i].second;
-    }
-    mListStart.push_back(std::uint32_t(pairs.size()));
-    const std::size_t slots = std::bit_ceil(std::max<std::size_t>(2, 2 * mFineKeys.size()));
-    mFineShift = 64 - std::countr_zero(slots);
-    mFineTable.assign(slots, 0);
-    for (std::size_t list = 0; list < mFineKeys.size(); ++list) {
-      std::size_t s = fineSlot(mFineKeys[list]);
-      while (mFineTable[s]) s = (s + 1) & (slots - 1);
-      mFineTable[s] = std::uint32_t(list + 1);
-    }
+    for (std::size_t i = 0; i < pairs.size(); ++i) mListed[i] = pairs[i].second;
   }
 
-  static std::uint64_t fineKey(int x, int y, int z) {
-    return (std::uint64_t(z) << 42) | (std::uint64_t(y) << 21) | std::uint64_t(x);
-  }
-  std::size_t fineSlot(std::uint64_t key) const { return std::size_t((key * 0x9e3779b97f4a7c15ull) >> mFineShift); }
-
-  /// The list of the fine cell of candidate p (inside [mLo, mHi]), or -1 where none is near.
+  /// The fine list of candidate p (inside [mLo, mHi]), or -1 where no query is near its cell.
   std::int64_t fineListOf(const glm::vec3& p) const {
-    const glm::ivec3 c =
-        glm::clamp(glm::ivec3(glm::floor((glm::dvec3(p) - mFine.lo) * mFine.inverse)), glm::ivec3(0), mFine.dims - 1);
-    const std::uint64_t key = fineKey(c.x, c.y, c.z);
-    for (std::size_t s = fineSlot(key); mFineTable[s]; s = (s + 1) & (mFineTable.size() - 1))
-      if (mFineKeys[mFineTable[s] - 1] == key) return std::int64_t(mFineTable[s] - 1);
-    return -1;
+    const glm::u64vec3 c(
+        glm::clamp(glm::ivec3(glm::floor((glm::dvec3(p) - mFine.lo) * mFine.inverse)), glm::ivec3(0), mFine.dims - 1));
+    return mFineLists.find(cellKey(c.x, c.y, c.z));
   }
 
   /// The bit of the cell of p, a point inside [mLo, mHi].
@@ -453,10 +475,12 @@ class KthNeighbours {
         const std::size_t bit = std::size_t(cells[k]);
         const std::uint64_t word = mBits[bit / 64];
         if (!(word >> (bit % 64) & 1)) continue;
-        if (mFineKeys.empty()) {
-          measure(candidates[first + k], idOf(first + k), listOf(bit, word), hits);
+        if (mFineLists.size() == 0) {
+          const std::size_t list = listOf(bit, word);
+          measure(candidates[first + k], idOf(first + k), mListStart[list], mListStart[list + 1], hits);
         } else if (const std::int64_t list = fineListOf(candidates[first + k]); list >= 0) {
-          measure(candidates[first + k], idOf(first + k), std::size_t(list), hits);
+          measure(candidates[first + k], idOf(first + k), mFineLists.first(std::size_t(list)),
+                  mFineLists.end(std::size_t(list)), hits);
         }
       }
     }
@@ -507,9 +531,10 @@ class KthNeighbours {
   }
 
   /// Measures a candidate whose cell has a list against the list's queries.
-  void measure(const glm::vec3& candidate, std::uint64_t id, std::size_t list, std::vector<Hit>& hits) const {
+  void measure(const glm::vec3& candidate, std::uint64_t id, std::uint32_t first, std::uint32_t end,
+               std::vector<Hit>& hits) const {
     const float radius2 = float(mRadius * mRadius);
-    for (std::uint32_t i = mListStart[list]; i < mListStart[list + 1]; ++i) {
+    for (std::uint32_t i = first; i < end; ++i) {
       const std::uint32_t j = mListed[i];
       if (mQueries.ids[j] == id) continue;
       const glm::vec3 d = mQueries.positions[j] - candidate;
@@ -526,12 +551,9 @@ class KthNeighbours {
   glm::ivec3 mDims{0};                    ///< of the cells over [mLo, mHi]
   std::vector<std::uint64_t> mBits;       ///< a bit per cell (x fastest): its list is not empty
   std::vector<std::uint32_t> mWordRank;   ///< per word of mBits, the set bits before it
-  std::vector<std::uint32_t>
-      mListStart;  ///< per set bit (per fine cell), its list's first entry in mListed; then the end
-  CellGrid mFine;  ///< buildFineLists' cells, where it ran
-  std::vector<std::uint64_t> mFineKeys;   ///< per fine list, its cell's key (fineKey); empty: the bits' lists
-  std::vector<std::uint32_t> mFineTable;  ///< open addressing: a fine list + 1, or 0
-  int mFineShift = 64;
+  std::vector<std::uint32_t> mListStart;  ///< per set bit, its list's first entry in mListed; then the end
+  CellGrid mFine;                         ///< buildFineLists' cells, where it ran
+  CellRuns mFineLists;                    ///< the fine lists' entries in mListed; empty: the bits' lists
   std::vector<std::uint32_t> mListed;     ///< the queries of each list
   std::vector<double> mAxisDistance2[3];  ///< forEachCellNear's scratch
   std::vector<float> mHeaps;  ///< k squared distances per query, a max-heap each
@@ -602,8 +624,8 @@ std::vector<double> kthAmongPoints(std::span<const glm::vec3> points, double rad
   const glm::dvec3 axisCells = glm::floor(extent / cell) + 3.0;
   constexpr double kDenseCellsPerPoint = 8;
   const bool dense = axisCells.x * axisCells.y * axisCells.z <= std::max(4096.0, kDenseCellsPerPoint * double(n));
-  const std::uint64_t rowCells = dense ? std::uint64_t(axisCells.x) : std::uint64_t(1) << 21;
-  const std::uint64_t sliceCells = rowCells * (dense ? std::uint64_t(axisCells.y) : std::uint64_t(1) << 21);
+  const std::uint64_t rowCells = dense ? std::uint64_t(axisCells.x) : cellKey(0, 1, 0);
+  const std::uint64_t sliceCells = dense ? rowCells * std::uint64_t(axisCells.y) : cellKey(0, 0, 1);
   const auto cellOf = [&](const glm::vec3& p) {
     const glm::u64vec3 c(glm::floor((glm::dvec3(p) - lo) / cell) + 1.0);
     return c.z * sliceCells + c.y * rowCells + c.x;
@@ -623,49 +645,28 @@ std::vector<double> kthAmongPoints(std::span<const glm::vec3> points, double rad
     std::sort(order.begin(), order.end());
   }
   std::vector<glm::vec3> sorted(n);  // the points in the order of their cells
-  std::vector<std::uint64_t> runCell;
-  std::vector<std::uint32_t> runStart;  // each occupied cell's first point, then n
-  for (std::size_t k = 0; k < n; ++k) {
-    sorted[k] = points[order[k].second];
-    if (k == 0 || order[k].first != order[k - 1].first) {
-      runCell.push_back(order[k].first);
-      runStart.push_back(std::uint32_t(k));
-    }
-  }
-  runStart.push_back(std::uint32_t(n));
-  // Sparse: open addressing, at most half full, each slot a run + 1 or 0.
-  const std::size_t slots = dense ? 0 : std::bit_ceil(2 * runCell.size());
-  const int shift = dense ? 0 : 64 - std::countr_zero(slots);
-  const auto slotOf = [&](std::uint64_t c) { return std::size_t((c * 0x9e3779b97f4a7c15ull) >> shift); };
-  std::vector<std::uint32_t> table(slots, 0);
-  for (std::size_t r = 0; r < (dense ? 0 : runCell.size()); ++r) {
-    std::size_t s = slotOf(runCell[r]);
-    while (table[s]) s = (s + 1) & (slots - 1);
-    table[s] = std::uint32_t(r + 1);
-  }
+  for (std::size_t k = 0; k < n; ++k) sorted[k] = points[order[k].second];
+  const CellRuns runs(order, !dense);
   const float radius2 = float(radius * radius);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, runCell.size(), 256), [&](const auto& range) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, runs.size(), 256), [&](const auto& range) {
     std::vector<float> near;
     std::array<std::pair<std::uint32_t, std::uint32_t>, 27> around;  // runs of points to measure
     for (std::size_t r = range.begin(); r != range.end(); ++r) {
-      std::size_t runs = 0;
-      for (const std::uint64_t slice : {runCell[r] - sliceCells, runCell[r], runCell[r] + sliceCells})
+      std::size_t arounds = 0;
+      for (const std::uint64_t slice : {runs.cell(r) - sliceCells, runs.cell(r), runs.cell(r) + sliceCells})
         for (const std::uint64_t row : {slice - rowCells, slice, slice + rowCells}) {
           if (dense) {
-            around[runs++] = {firstPoint[row - 1], firstPoint[row + 2]};
+            around[arounds++] = {firstPoint[row - 1], firstPoint[row + 2]};
             continue;
           }
           for (std::uint64_t c = row - 1; c <= row + 1; ++c)
-            for (std::size_t s = slotOf(c); table[s]; s = (s + 1) & (slots - 1))
-              if (runCell[table[s] - 1] == c) {
-                around[runs++] = {runStart[table[s] - 1], runStart[table[s]]};
-                break;
-              }
+            if (const std::int64_t run = runs.find(c); run >= 0)
+              around[arounds++] = {runs.first(std::size_t(run)), runs.end(std::size_t(run))};
         }
-      for (std::size_t k = runStart[r]; k < runStart[r + 1]; ++k) {
+      for (std::size_t k = runs.first(r); k < runs.end(r); ++k) {
         near.clear();
         const glm::vec3 q = sorted[k];
-        for (std::size_t a = 0; a < runs; ++a)
+        for (std::size_t a = 0; a < arounds; ++a)
           for (std::size_t j = around[a].first; j < around[a].second; ++j) {
             const glm::vec3 d = q - sorted[j];
             const float d2 = d.x * d.x + d.y * d.y + d.z * d.z;
