@@ -25,8 +25,10 @@ ResolvedRender resolve(const RenderRequest& request, const BrickStore& store) {
 }
 
 Camera defaultRenderCamera(BrickSource& source, int first, int last, std::uint32_t width, std::uint32_t height,
-                           glm::dvec3 up) {
-  Box bounds = occupiedBounds(source, first, last);
+                           glm::dvec3 up, std::uint64_t* particlesLeftOut) {
+  const FramedBounds framed = framedBounds(source, first, last);
+  if (particlesLeftOut) *particlesLeftOut = framed.particlesLeftOut;
+  Box bounds = framed.box;
   if (bounds.isEmpty()) bounds = Box{source.header().origin, source.header().domainMax()};
   try {
     return frameOnBox(bounds, double(width) / height, up);

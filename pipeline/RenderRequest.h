@@ -41,10 +41,11 @@ struct ResolvedRender {
 /// look uses the store's attribute.
 ResolvedRender resolve(const RenderRequest& request, const BrickStore& store);
 
-/// The camera a render frames when none is given: frameOnBox over the occupied cells of every
-/// frame of [first, last] (one camera for a whole flipbook), or over the domain when they hold
-/// no brick. Throws FileError naming the source when no camera can frame it.
+/// The camera a render frames when none is given: frameOnBox over the framedBounds of every
+/// frame of [first, last] (one camera for a whole flipbook: the occupied cells less particles
+/// flung far away, whose count goes to `particlesLeftOut` when given), or over the domain when
+/// they hold no brick. Throws FileError naming the source when no camera can frame it.
 Camera defaultRenderCamera(BrickSource& source, int first, int last, std::uint32_t width, std::uint32_t height,
-                           glm::dvec3 up);
+                           glm::dvec3 up, std::uint64_t* particlesLeftOut = nullptr);
 
 }  // namespace flipscope

@@ -2,6 +2,7 @@
 #include "streaming/BrickSource.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <limits>
 
@@ -29,17 +30,30 @@ std::shared_ptr<const DecodedBrick> StoreBrickSource::read(const BrickKey& key) 
   return std::make_shared<const DecodedBrick>(mStore.readBrick(*frame, std::uint32_t(index), mAttributes));
 }
 
-Box occupiedBounds(BrickSource& source, int first, int last) {
+namespace {
+
+using FrameIndices = std::vector<std::shared_ptr<const FrameIndex>>;
+
+FrameIndices frameIndices(BrickSource& source, int first, int last) {
+  FrameIndices frames;
+  for (int f = first; f <= last; ++f) frames.push_back(source.frame(f));
+  return frames;
+}
+
+bool within(glm::uvec3 c, glm::uvec3 lo, glm::uvec3 hi) {
+  return glm::all(glm::greaterThanEqual(c, lo)) && glm::all(glm::lessThanEqual(c, hi));
+}
+
+/// occupiedBounds of the bricks of `frames` whose coordinates lie within [windowLo, windowHi].
+Box occupiedBoundsWithin(BrickSource& source, const FrameIndices& frames, glm::uvec3 windowLo, glm::uvec3 windowHi) {
   const StoreHeader& h = source.header();
-  std::vector<std::shared_ptr<const FrameIndex>> frames;
   glm::uvec3 lo(~0u), hi(0u);
-  for (int f = first; f <= last; ++f) {
-    frames.push_back(source.frame(f));
-    for (const BrickRecord& record : frames.back()->bricks) {
-      lo = glm::min(lo, record.coord);
-      hi = glm::max(hi, record.coord);
-    }
-  }
+  for (const auto& index : frames)
+    for (const BrickRecord& record : index->bricks)
+      if (within(record.coord, windowLo, windowHi)) {
+        lo = glm::min(lo, record.coord);
+        hi = glm::max(hi, record.coord);
+      }
   if (lo.x > hi.x) return {};  // no bricks in any frame
   // Bricks on the outer layers of all frames decide the bounds: decode them (up to a limit over
   // the whole range) for cell-exact bounds, so a default camera frames the fluid, not its bricks.
@@ -48,7 +62,8 @@ Box occupiedBounds(BrickSource& source, int first, int last) {
   for (const auto& index : frames) {
     for (std::uint32_t i = 0; i < index->bricks.size(); ++i) {
       const glm::uvec3 c = index->bricks[i].coord;
-      if (glm::any(glm::equal(c, lo)) || glm::any(glm::equal(c, hi))) outer.emplace_back(index.get(), i);
+      if (within(c, lo, hi) && (glm::any(glm::equal(c, lo)) || glm::any(glm::equal(c, hi))))
+        outer.emplace_back(index.get(), i);
     }
   }
   const glm::dvec3 lower(lo * h.brickSize), upper((hi + 1u) * h.brickSize);
@@ -83,6 +98,51 @@ Box occupiedBounds(BrickSource& source, int first, int last) {
       });
   if (cells.first.x > cells.second.x) return Box{h.origin + lower * h.cellSize, h.origin + upper * h.cellSize};
   return Box{h.origin + glm::dvec3(cells.first) * h.cellSize, h.origin + glm::dvec3(cells.second) * h.cellSize};
+}
+
+}  // namespace
+
+Box occupiedBounds(BrickSource& source, int first, int last) {
+  return occupiedBoundsWithin(source, frameIndices(source, first, last), glm::uvec3(0u), glm::uvec3(~0u));
+}
+
+FramedBounds framedBounds(BrickSource& source, int first, int last) {
+  const FrameIndices frames = frameIndices(source, first, last);
+  const glm::uvec3 grid = source.header().brickGrid;
+  // Per axis, the particles of each brick coordinate.
+  std::array<std::vector<std::uint64_t>, 3> histograms;
+  for (int a = 0; a < 3; ++a) histograms[a].assign(grid[a], 0);
+  FramedBounds out;
+  for (const auto& index : frames)
+    for (const BrickRecord& record : index->bricks) {
+      if (!within(record.coord, glm::uvec3(0u), grid - 1u)) continue;  // an index holds none (BrickStore)
+      for (int a = 0; a < 3; ++a) histograms[a][record.coord[a]] += record.particles;
+      out.particles += record.particles;
+    }
+  // The bulk per axis: the coordinates past the tails of at most kFramingTail of the particles.
+  const auto tail = std::uint64_t(double(out.particles) * kFramingTail);
+  glm::uvec3 bulkLo(0u), bulkHi(0u);
+  std::uint32_t extent = 0;
+  for (int a = 0; a < 3 && out.particles > 0; ++a) {
+    const std::vector<std::uint64_t>& h = histograms[a];
+    std::uint64_t below = 0, above = 0;
+    std::uint32_t lo = 0, hi = grid[a] - 1;
+    while (below + h[lo] <= tail) below += h[lo++];
+    while (above + h[hi] <= tail) above += h[hi--];
+    bulkLo[a] = lo;
+    bulkHi[a] = hi;
+    extent = std::max(extent, hi - lo + 1);
+  }
+  glm::uvec3 windowLo(0u), windowHi(~0u);
+  for (int a = 0; a < 3 && out.particles > 0; ++a) {
+    windowLo[a] = bulkLo[a] - std::min(bulkLo[a], extent);
+    windowHi[a] = bulkHi[a] + extent;
+  }
+  for (const auto& index : frames)
+    for (const BrickRecord& record : index->bricks)
+      if (!within(record.coord, windowLo, windowHi)) out.particlesLeftOut += record.particles;
+  out.box = occupiedBoundsWithin(source, frames, windowLo, windowHi);
+  return out;
 }
 
 }  // namespace flipscope

@@ -104,7 +104,24 @@ class StoreBrickSource : public BrickSource {
 
 /// World box of the occupied cells of frames [first, last] of `source` (empty box when they hold
 /// no brick). Cell-exact from the bricks on the outer layers, or brick-exact when more than a
-/// few thousand bricks form them across the range. What a default camera frames.
+/// few thousand bricks form them across the range.
 Box occupiedBounds(BrickSource& source, int first, int last);
+
+/// What a default camera frames (framedBounds): the occupied cells, less particles far away.
+struct FramedBounds {
+  Box box;                             ///< as occupiedBounds, over the bricks kept
+  std::uint64_t particlesLeftOut = 0;  ///< of the bricks left out, over all frames of the range
+  std::uint64_t particles = 0;         ///< of every brick, over all frames of the range
+};
+
+/// The box a default camera frames over frames [first, last]: occupiedBounds of the bricks that
+/// lie near the bulk of the particles. Per axis, the bulk is the range of brick coordinates that
+/// holds all but kFramingTail of the particles at each end (by the bricks' particle counts); a
+/// brick is kept when, along every axis, it lies within the bulk's longest extent of the bulk.
+/// So spray and splashes within a tank's size of the liquid are framed, and the few particles a
+/// solver flung ten thousand tank sizes away (whose bricks the domain then holds) are not, where
+/// framing them would leave the liquid a speck.
+FramedBounds framedBounds(BrickSource& source, int first, int last);
+inline constexpr double kFramingTail = 5e-4;
 
 }  // namespace flipscope

@@ -72,55 +72,126 @@ TEST_F(StoreBrickSourceTest, ReadsWhatWasWritten) {
   EXPECT_EQ(source.read({1, {0xffffffffu, 0, 0}}), nullptr);  // outside the grid
 }
 
+/// A brick of a one-frame store: its cells (brick-local) and the particles in each.
+struct CellsOfBrick {
+  glm::uvec3 coord;
+  std::vector<glm::uvec3> cells;
+  std::uint32_t particlesPerCell = 1;
+};
+
+/// Writes frame 0 of a store of bricks of 32 at `dir` (emptied first) holding `bricks`.
+void writeStore(const std::filesystem::path& dir, const StoreHeader& header, const std::vector<CellsOfBrick>& bricks) {
+  std::filesystem::remove_all(dir);
+  BrickStore store = BrickStore::createOrAppend(dir, header);
+  std::vector<const CellsOfBrick*> order;
+  for (const CellsOfBrick& b : bricks) order.push_back(&b);
+  std::sort(order.begin(), order.end(), [&](const CellsOfBrick* a, const CellsOfBrick* b) {
+    return mortonEncode3(a->coord.x, a->coord.y, a->coord.z) < mortonEncode3(b->coord.x, b->coord.y, b->coord.z);
+  });
+  FrameWriter writer(store.framePath(0), store.header(), 0);
+  FrameStats stats;
+  for (const CellsOfBrick* b : order) {
+    DecodedBrick brick;
+    for (const glm::uvec3 c : b->cells) brick.cells.push_back(c.x + 32 * (c.y + 32 * c.z));
+    std::sort(brick.cells.begin(), brick.cells.end());
+    brick.counts.assign(brick.cells.size(), b->particlesPerCell);
+    const auto particles = std::uint32_t(brick.cells.size()) * b->particlesPerCell;
+    writer.addBrick(b->coord, particles, std::uint32_t(brick.cells.size()), encodeBrick(brick, 1));
+    stats.particles += particles;
+  }
+  writer.finish(stats);
+  store.addFrame(0);
+}
+
+std::filesystem::path testDirectory(const std::string& name) {
+  return std::filesystem::temp_directory_path() /
+         ("flipscope-" + name + "-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+}
+
+/// World box of the cells of `bricks`, one by one.
+Box cellBox(const StoreHeader& header, const std::vector<CellsOfBrick>& bricks) {
+  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
+  for (const CellsOfBrick& b : bricks)
+    for (const glm::uvec3 c : b.cells) {
+      lo = glm::min(lo, glm::dvec3(b.coord * 32u + c));
+      hi = glm::max(hi, glm::dvec3(b.coord * 32u + c) + 1.0);
+    }
+  return Box{header.origin + lo * header.cellSize, header.origin + hi * header.cellSize};
+}
+
 TEST(OccupiedBounds, AreTheCellBoundsOfEveryBrick) {
   // occupiedBounds decodes the outer bricks only; every brick's cells, one by one, give the same.
   // A few cells in bricks of 32 on a 4x3x3 grid, none on a brick's face but one.
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("flipscope-occupied-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
-  std::filesystem::remove_all(dir);
+  const auto dir = testDirectory("occupied");
   StoreHeader header;
   header.brickSize = 32;
   header.cellSize = 0.25;
   header.origin = {-1, 2, 0.5};
   header.brickGrid = {4, 3, 3};
-  const std::vector<std::pair<glm::uvec3, std::vector<glm::uvec3>>> bricks = {
-      {{0, 1, 2}, {{5, 7, 9}, {30, 2, 3}}},  // in Morton order
+  const std::vector<CellsOfBrick> bricks = {
+      {{0, 1, 2}, {{5, 7, 9}, {30, 2, 3}}},
       {{2, 0, 1}, {{1, 31, 0}}},
       {{1, 1, 1}, {{0, 0, 0}}},  // inside: never decoded
       {{3, 2, 0}, {{12, 4, 17}, {6, 20, 21}}},
   };
-  {
-    BrickStore store = BrickStore::createOrAppend(dir, header);
-    std::vector<std::size_t> order(bricks.size());
-    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-      const glm::uvec3 p = bricks[a].first, q = bricks[b].first;
-      return mortonEncode3(p.x, p.y, p.z) < mortonEncode3(q.x, q.y, q.z);
-    });
-    FrameWriter writer(store.framePath(0), store.header(), 0);
-    FrameStats stats;
-    for (std::size_t i : order) {
-      DecodedBrick brick;
-      for (const glm::uvec3 c : bricks[i].second) brick.cells.push_back(c.x + 32 * (c.y + 32 * c.z));
-      std::sort(brick.cells.begin(), brick.cells.end());
-      brick.counts.assign(brick.cells.size(), 1);
-      writer.addBrick(bricks[i].first, std::uint32_t(brick.cells.size()), std::uint32_t(brick.cells.size()),
-                      encodeBrick(brick, 1));
-      stats.particles += brick.cells.size();
-    }
-    writer.finish(stats);
-    store.addFrame(0);
-  }
-  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
-  for (const auto& [coord, cells] : bricks)
-    for (const glm::uvec3 c : cells) {
-      lo = glm::min(lo, glm::dvec3(coord * 32u + c));
-      hi = glm::max(hi, glm::dvec3(coord * 32u + c) + 1.0);
-    }
+  writeStore(dir, header, bricks);
   StoreBrickSource source(BrickStore::open(dir));
   const Box bounds = occupiedBounds(source, 0, 0);
-  EXPECT_EQ(bounds.min, header.origin + lo * header.cellSize);
-  EXPECT_EQ(bounds.max, header.origin + hi * header.cellSize);
+  const Box expected = cellBox(header, bricks);
+  EXPECT_EQ(bounds.min, expected.min);
+  EXPECT_EQ(bounds.max, expected.max);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(FramedBounds, LeaveOutAFewParticlesFarAwayAndKeepSprayNearAndManyFar) {
+  // The bulk: 8 bricks of 2 cells of 500 particles (8000), x in [0, 3] and y in [0, 1]: its
+  // longest extent is 4 bricks, so bricks up to x = 3 + 4 = 7 are near it. The tail at each end
+  // is 8000 * kFramingTail = 4 particles.
+  const auto dir = testDirectory("framed");
+  StoreHeader header;
+  header.brickSize = 32;
+  header.cellSize = 0.5;
+  header.origin = {3, -2, 1};
+  header.brickGrid = {64, 64, 2};
+  std::vector<CellsOfBrick> bulk;
+  for (std::uint32_t x = 0; x < 4; ++x)
+    for (std::uint32_t y = 0; y < 2; ++y) bulk.push_back({{x, y, 0}, {{3, 9, 4}, {20, 17, 28}}, 500});
+  const auto framed = [&](const std::vector<CellsOfBrick>& extra) {
+    std::vector<CellsOfBrick> all = bulk;
+    all.insert(all.end(), extra.begin(), extra.end());
+    writeStore(dir, header, all);
+    StoreBrickSource source(BrickStore::open(dir));
+    const FramedBounds f = framedBounds(source, 0, 0);
+    const Box occupied = occupiedBounds(source, 0, 0);
+    EXPECT_EQ(occupied.min, cellBox(header, all).min);
+    EXPECT_EQ(occupied.max, cellBox(header, all).max);
+    return f;
+  };
+  const Box bulkBox = cellBox(header, bulk);
+
+  // Four particles flung far along x and one far along y (each in a tail of at most 4): left out.
+  FramedBounds f = framed({{{60, 0, 0}, {{1, 1, 1}}, 4}, {{2, 63, 1}, {{31, 31, 31}}}});
+  EXPECT_EQ(f.particles, 8005u);
+  EXPECT_EQ(f.particlesLeftOut, 5u);
+  EXPECT_EQ(f.box.min, bulkBox.min);
+  EXPECT_EQ(f.box.max, bulkBox.max);
+
+  // Spray a bulk's extent away (brick x = 7), and beside the bulk above it (y = 5): framed.
+  const std::vector<CellsOfBrick> spray = {{{7, 0, 0}, {{31, 0, 0}}}, {{1, 5, 1}, {{0, 31, 31}}}};
+  f = framed(spray);
+  EXPECT_EQ(f.particlesLeftOut, 0u);
+  std::vector<CellsOfBrick> withSpray = bulk;
+  withSpray.insert(withSpray.end(), spray.begin(), spray.end());
+  EXPECT_EQ(f.box.min, cellBox(header, withSpray).min);
+  EXPECT_EQ(f.box.max, cellBox(header, withSpray).max);
+
+  // One brick further (x = 8): left out. Five particles there (more than the tail): framed.
+  f = framed({{{8, 0, 0}, {{0, 0, 0}}}});
+  EXPECT_EQ(f.particlesLeftOut, 1u);
+  EXPECT_EQ(f.box.max, bulkBox.max);
+  f = framed({{{60, 0, 0}, {{0, 0, 0}}, 5}});
+  EXPECT_EQ(f.particlesLeftOut, 0u);
+  EXPECT_EQ(f.box.max.x, header.origin.x + (60 * 32 + 1) * header.cellSize);
   std::filesystem::remove_all(dir);
 }
 

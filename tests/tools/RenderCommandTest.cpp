@@ -120,6 +120,31 @@ TEST_F(Render, AHoudiniFileRendersWithDefaults) {
   EXPECT_GT(covered, 64u * 36u / 20) << "the default camera frames the Houdini points";
 }
 
+// One particle flung ten thousand tank sizes away, converted with no options, lies in the store's
+// domain: the default camera frames the tank without it, says so, and the tank fills the image.
+TEST_F(Render, TheDefaultCameraLeavesOutAParticleFlungFarAway) {
+  {
+    std::ofstream ply(path("flung.ply"));
+    const int n = 20;
+    ply << "ply\nformat ascii 1.0\nelement vertex " << n * n * n + 1
+        << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+    for (int k = 0; k < n; ++k)
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) ply << 0.05 * i << ' ' << 0.05 * j << ' ' << 0.05 * k << '\n';
+    ply << "10000 0.5 0.5\n";
+  }
+  CommandRun convert = runFlipscope("convert " + path("flung.ply") + " -o " + path("flung"));
+  ASSERT_EQ(convert.exitCode, 0) << convert.output;
+  CommandRun render =
+      runFlipscope("render " + path("flung") + " -o " + path("flung.exr") + " --size 64x36 --device cpu");
+  ASSERT_EQ(render.exitCode, 0) << render.output;
+  EXPECT_NE(render.output.find("leaves out 1 particle far from it"), std::string::npos) << render.output;
+  const flipscope::RenderImage image = flipscope::readExr(path("flung.exr")).image;
+  std::size_t covered = 0;
+  for (float depth : image.depth) covered += std::isfinite(depth);
+  EXPECT_GT(covered, 64u * 36u / 10) << "the default camera frames the tank, not the particle far away";
+}
+
 TEST_F(Render, SmoothingAndShadingOptionsChangeTheImage) {
   const auto render = [&](const std::string& name, const std::string& options) {
     return renderExr(name, options).image;

@@ -257,7 +257,7 @@ void ViewerApp::onKey(const std::string& name) {
     mTimeline->end();
   } else if (name == "f") {
     const glm::uvec2 size = renderSize();
-    mNavigation->frame(occupiedBounds(*mSource, mTimeline->frame(), mTimeline->frame()), double(size.x) / size.y);
+    mNavigation->frame(framedBounds(*mSource, mTimeline->frame(), mTimeline->frame()).box, double(size.x) / size.y);
   } else if (name == "r") {
     mNavigation->reset();
   } else if (name == "tab") {
