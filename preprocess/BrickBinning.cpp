@@ -515,7 +515,7 @@ void binKeys(KeyBatch& keyBatch, const KeyGrid& grid, float min, float max, int 
     e.coord = glm::uvec3(mortonDecode3(std::uint32_t(parts.code)));
     e.particles = std::uint32_t(parts.keys());
     e.cells = std::uint32_t(brick.cells.size());
-    encodeBrickInto(brick, zstdLevel, e.payload);
+    encodeBrickInto(brick, zstdLevel, e.payload, attributeCodingOf(grid.header.version));
     return k;
   };
   const auto write = [&](std::size_t k) { sink(ring[k % slots]); };

@@ -59,10 +59,12 @@ namespace flipscope {
 /// 5: StoreHeader::particleKinds in store.fsh, a kind per cell in the payloads of such stores,
 /// and FrameStats::kindCells in the frame footer (136 bytes, 104 before).
 /// 6: StoreHeader::upAxis in store.fsh; frame files unchanged but for their version.
-/// Version 3 to 5 stores are read and appended to as what they are (no up axis; version 3 and 4:
-/// no kinds; version 3: speed or no attribute, its range gathered from the frames); older ones
-/// are refused (convert again).
-inline constexpr std::uint32_t kStoreVersion = 6;
+/// 7: payloads code their attribute values as deltas in byte planes (AttributeCoding); store.fsh
+/// unchanged but for its version.
+/// Version 3 to 6 stores are read and appended to as what they are (attribute values as they
+/// are; version 3 to 5: no up axis; version 3 and 4: no kinds; version 3: speed or no attribute,
+/// its range gathered from the frames); older ones are refused (convert again).
+inline constexpr std::uint32_t kStoreVersion = 7;
 inline constexpr std::uint32_t kOldestStoreVersion = 3;
 inline constexpr char kStoreHeaderName[] = "store.fsh";
 /// Frame numbers a store holds: 0 to kMaxFrame (six digits in the file name).
@@ -164,11 +166,21 @@ struct DecodedBrick {
   std::uint64_t particleCount() const;
 };
 
-/// Payload codec (exposed for tests and the streaming benchmark).
-std::vector<std::byte> encodeBrick(const DecodedBrick& brick, int zstdLevel);
+/// How a payload holds its attribute values (BrickCodec.cpp): as they are (versions 3 to 6), or,
+/// from version 7, as deltas in byte planes, which zstd packs into about half the bytes.
+enum class AttributeCoding { Values, CellDeltas };
+inline constexpr AttributeCoding attributeCodingOf(std::uint32_t storeVersion) {
+  return storeVersion >= 7 ? AttributeCoding::CellDeltas : AttributeCoding::Values;
+}
+
+/// Payload codec (exposed for tests and the streaming benchmark); `coding` is the store
+/// version's (attributeCodingOf).
+std::vector<std::byte> encodeBrick(const DecodedBrick& brick, int zstdLevel,
+                                   AttributeCoding coding = attributeCodingOf(kStoreVersion));
 /// encodeBrick into `payload`, whose capacity is reused: binning recycles a few payload
 /// buffers, where a fresh one per brick cost a first touch of every payload page.
-void encodeBrickInto(const DecodedBrick& brick, int zstdLevel, UninitializedVector<std::byte>& payload);
+void encodeBrickInto(const DecodedBrick& brick, int zstdLevel, UninitializedVector<std::byte>& payload,
+                     AttributeCoding coding = attributeCodingOf(kStoreVersion));
 /// Throws FileError naming `file` and `brickIndex` on any malformation; checks `expected`
 /// particle and cell counts, that every cell index is < cellsPerBrick and, with `hasKinds`,
 /// that every kind is < kParticleKindCount. Without `readAttributes`, a payload's attribute
@@ -176,7 +188,8 @@ void encodeBrickInto(const DecodedBrick& brick, int zstdLevel, UninitializedVect
 /// are decompressed and checked (a render that shows no attribute; most of a payload's bytes).
 DecodedBrick decodeBrick(std::span<const std::byte> payload, const std::filesystem::path& file,
                          std::uint32_t brickIndex, const BrickRecord& expected, std::uint32_t cellsPerBrick,
-                         bool hasAttribute, bool hasKinds, bool readAttributes = true);
+                         bool hasAttribute, bool hasKinds, bool readAttributes = true,
+                         AttributeCoding coding = attributeCodingOf(kStoreVersion));
 
 class BrickStore {
  public:

@@ -292,7 +292,8 @@ TEST(FuzzCorpus, Write) {
   // forms: the fuzz target's 9-byte prefix (particles, cells, flags), then the payload.
   const auto writePayloadSeeds = [&](const DecodedBrick& brick, std::uint32_t sizeIndex, std::uint8_t flags,
                                      const std::string& name) {
-    const std::vector<std::byte> payload = encodeBrick(brick, 3);
+    const std::vector<std::byte> payload =
+        encodeBrick(brick, 3, flags & 32 ? AttributeCoding::Values : AttributeCoding::CellDeltas);
     for (bool rawForm : {false, true}) {
       std::vector<std::byte> body = payload;
       if (rawForm) {
@@ -340,6 +341,20 @@ TEST(FuzzCorpus, Write) {
       writePayloadSeeds(brick, sizeIndex, std::uint8_t((attribute ? 1 : 0) | 16),
                         "b" + std::to_string(brickSize) + (attribute ? "_speed" : "") + "_kinds");
     }
+
+  // Brick payloads whose attribute values are laid out as versions 3 to 6 lay them out (flag 32,
+  // AttributeCoding::Values).
+  std::mt19937 valuesRng(19);
+  for (std::uint32_t sizeIndex = 0; sizeIndex < 2; ++sizeIndex) {
+    DecodedBrick brick;
+    const std::uint32_t brickSize = 32u << sizeIndex, cells = brickSize * brickSize * brickSize;
+    for (std::uint32_t cell = valuesRng() % 50; cell < cells; cell += 1 + std::uint32_t(valuesRng() % 3000)) {
+      brick.cells.push_back(cell);
+      brick.counts.push_back(1 + std::uint32_t(valuesRng() % 9));
+      for (std::uint32_t i = 0; i < brick.counts.back(); ++i) brick.attributes.push_back(std::uint16_t(valuesRng()));
+    }
+    writePayloadSeeds(brick, sizeIndex, 1 | 32, "b" + std::to_string(brickSize) + "_speed_values");
+  }
 
   // Cameras.
   saveCamera(corpus / "camera" / "full.json", Camera{{2, 1.5, 3}, {0.5, 0.2, 0.5}, {0, 1, 0}, 35});

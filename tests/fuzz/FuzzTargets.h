@@ -17,7 +17,8 @@
 //   brick_payload           u32 particles, u32 cells, u8 flags (bit 0: attribute, bits 1-2:
 //                           brick size 32 / 64 / 128, bit 3: the rest is the raw payload, which
 //                           the target compresses; else it is the zstd payload; bit 4: a kind
-//                           per cell), then the payload
+//                           per cell; bit 5: attribute values as versions 3 to 6 code them,
+//                           AttributeCoding::Values, else as deltas), then the payload
 //   camera                  camera JSON
 #pragma once
 
@@ -203,7 +204,8 @@ inline Result frameIndex(std::span<const std::byte> input) {
         const BrickRecord& b = index.bricks[i];
         try {
           decodeBrick(bytes.subspan(b.offset, b.bytes), "frame", i, b, header.cellsPerBrick(),
-                      header.attribute != AttributeKind::None, header.particleKinds);
+                      header.attribute != AttributeKind::None, header.particleKinds, true,
+                      attributeCodingOf(header.version));
         } catch (const FileError&) {
         }
       }
@@ -222,6 +224,7 @@ inline Result brickPayload(std::span<const std::byte> input) {
   const auto flags = std::uint8_t(input[8]);
   const bool attribute = flags & 1;
   const bool kinds = flags & 16;
+  const AttributeCoding coding = flags & 32 ? AttributeCoding::Values : AttributeCoding::CellDeltas;
   const std::uint32_t brickSize = 32u << std::min((flags >> 1) & 3, 2);
   std::span<const std::byte> payload = input.subspan(kHeader);
   std::vector<std::byte> compressed;
@@ -236,7 +239,8 @@ inline Result brickPayload(std::span<const std::byte> input) {
   // Without the attributes (a render that shows none) the streams before them decode alone.
   std::optional<DecodedBrick> streams;
   try {
-    streams = decodeBrick(payload, "brick", 0, record, brickSize * brickSize * brickSize, attribute, kinds, false);
+    streams =
+        decodeBrick(payload, "brick", 0, record, brickSize * brickSize * brickSize, attribute, kinds, false, coding);
     if (streams->particleCount() != record.particles || streams->cells.size() != record.cells ||
         !streams->attributes.empty())
       throw LogicError("decodeBrick without attributes accepted a brick that does not match its record");
@@ -244,14 +248,14 @@ inline Result brickPayload(std::span<const std::byte> input) {
   }
   try {
     const DecodedBrick brick =
-        decodeBrick(payload, "brick", 0, record, brickSize * brickSize * brickSize, attribute, kinds);
+        decodeBrick(payload, "brick", 0, record, brickSize * brickSize * brickSize, attribute, kinds, true, coding);
     if (brick.particleCount() != record.particles || brick.cells.size() != record.cells)
       throw LogicError("decodeBrick accepted a brick that does not match its record");
     if (!streams || streams->cells != brick.cells || streams->counts != brick.counts || streams->kinds != brick.kinds)
       throw LogicError("a brick decodes differently without its attributes");
     // What decodes must encode to the same brick.
-    const DecodedBrick again =
-        decodeBrick(encodeBrick(brick, 1), "brick", 0, record, brickSize * brickSize * brickSize, attribute, kinds);
+    const DecodedBrick again = decodeBrick(encodeBrick(brick, 1, coding), "brick", 0, record,
+                                           brickSize * brickSize * brickSize, attribute, kinds, true, coding);
     if (again.cells != brick.cells || again.counts != brick.counts || again.attributes != brick.attributes ||
         again.kinds != brick.kinds)
       throw LogicError("encodeBrick(decodeBrick(payload)) decodes differently");

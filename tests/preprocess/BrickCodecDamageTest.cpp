@@ -88,9 +88,11 @@ TEST(BrickCodecDamage, DeclaredSizeBeyondTheFrameIsRefusedCheaply) {
   } catch (const FileError& e) {
     EXPECT_NE(std::string(e.what()).find("f.fsf"), std::string::npos) << e.what();
   }
-  // The same frame with its true size decodes.
+  // The same frame with its true size decodes (its values as versions 3 to 6 lay them out).
   const std::vector<std::byte> good = compress(raw);
-  EXPECT_EQ(decodeBrick(good, "f.fsf", 0, record(1, 1u << 16), 32 * 32 * 32, true, false).attributes, attributes);
+  EXPECT_EQ(decodeBrick(good, "f.fsf", 0, record(1, 1u << 16), 32 * 32 * 32, true, false, true, AttributeCoding::Values)
+                .attributes,
+            attributes);
 }
 
 }  // namespace

@@ -7,6 +7,8 @@
 #include <limits>
 #include <random>
 
+#include <zstd.h>
+
 #include "core/AtomicFile.h"
 #include "core/Bytes.h"
 #include "core/Error.h"
@@ -42,18 +44,77 @@ DecodedBrick randomBrick(std::mt19937& rng, std::uint32_t cellsPerBrick, bool at
 
 TEST(BrickCodec, RoundTripsRandomBricks) {
   std::mt19937 rng(11);
-  for (int i = 0; i < 50; ++i) {
-    const bool attribute = i % 2;
-    DecodedBrick brick = randomBrick(rng, 64 * 64 * 64, attribute);
-    auto payload = encodeBrick(brick, 1);
-    BrickRecord r;
-    r.cells = std::uint32_t(brick.cells.size());
-    r.particles = std::uint32_t(brick.particleCount());
-    DecodedBrick back = decodeBrick(payload, "x.fsf", 3, r, 64 * 64 * 64, attribute, false);
-    EXPECT_EQ(back.cells, brick.cells);
-    EXPECT_EQ(back.counts, brick.counts);
-    EXPECT_EQ(back.attributes, brick.attributes);
+  for (const AttributeCoding coding : {AttributeCoding::Values, AttributeCoding::CellDeltas})
+    for (int i = 0; i < 50; ++i) {
+      const bool attribute = i % 2;
+      DecodedBrick brick = randomBrick(rng, 64 * 64 * 64, attribute);
+      // Values need not ascend in a cell for the codings: every tenth brick's are shuffled.
+      if (i % 10 == 1) std::shuffle(brick.attributes.begin(), brick.attributes.end(), rng);
+      auto payload = encodeBrick(brick, 1, coding);
+      BrickRecord r;
+      r.cells = std::uint32_t(brick.cells.size());
+      r.particles = std::uint32_t(brick.particleCount());
+      DecodedBrick back = decodeBrick(payload, "x.fsf", 3, r, 64 * 64 * 64, attribute, false, true, coding);
+      EXPECT_EQ(back.cells, brick.cells);
+      EXPECT_EQ(back.counts, brick.counts);
+      EXPECT_EQ(back.attributes, brick.attributes);
+    }
+}
+
+/// The decompressed payload of `brick`.
+std::vector<std::byte> rawPayload(const DecodedBrick& brick, AttributeCoding coding) {
+  const std::vector<std::byte> payload = encodeBrick(brick, 1, coding);
+  std::vector<std::byte> raw(ZSTD_getFrameContentSize(payload.data(), payload.size()));
+  EXPECT_EQ(ZSTD_decompress(raw.data(), raw.size(), payload.data(), payload.size()), raw.size());
+  return raw;
+}
+
+TEST(BrickCodec, AttributeValuesAreLaidOutAsEachCodingSays) {
+  // Cells 3 and 4 of 3 and 2 values: the streams before them are 5 bytes (one varint each).
+  DecodedBrick brick;
+  brick.cells = {3, 4};
+  brick.counts = {3, 2};
+  brick.attributes = {1000, 1002, 1300, 990, 65535};
+  const auto bytes = [](std::initializer_list<int> values) {
+    std::vector<std::byte> out;
+    for (int v : values) out.push_back(std::byte(v));
+    return out;
+  };
+  const std::vector<std::byte> streams = bytes({2, 3, 0, 2, 1});
+  // Versions 3 to 6: u16 little endian.
+  std::vector<std::byte> expected = streams;
+  for (const std::uint16_t v : brick.attributes)
+    for (const std::byte b : bytes({v & 0xff, v >> 8})) expected.push_back(b);
+  EXPECT_EQ(rawPayload(brick, AttributeCoding::Values), expected);
+  // Version 7: codes 2000 (zigzag of +1000), 2, 298, 19 (zigzag of 990 - 1000 = -10),
+  // 64545 (65535 - 990); their high bytes, then their low bytes.
+  const std::vector<std::uint16_t> codes = {2000, 2, 298, 19, 64545};
+  expected = streams;
+  for (const std::uint16_t c : codes) expected.push_back(std::byte(c >> 8));
+  for (const std::uint16_t c : codes) expected.push_back(std::byte(c & 0xff));
+  EXPECT_EQ(rawPayload(brick, AttributeCoding::CellDeltas), expected);
+  EXPECT_EQ(attributeCodingOf(6), AttributeCoding::Values);
+  EXPECT_EQ(attributeCodingOf(kStoreVersion), AttributeCoding::CellDeltas);
+}
+
+TEST(BrickCodec, CodedValuesOfASmoothFieldTakeLessThanHalfTheBytes) {
+  // A speed that varies smoothly over the brick, 8 particles a cell with a little noise: the
+  // values differ little from cell to cell and within a cell, but their low bytes vary.
+  std::mt19937 rng(3);
+  DecodedBrick brick;
+  for (std::uint32_t c = 0; c < 64 * 64 * 64; c += 2) {
+    brick.cells.push_back(c);
+    brick.counts.push_back(8);
+    const double x = c % 64, y = (c / 64) % 64, z = c / 4096;
+    const double speed = 20000 + 9000 * std::sin(x / 9) + 7000 * std::cos(y / 11) + 300 * z;
+    std::vector<std::uint16_t> values(8);
+    for (auto& v : values) v = std::uint16_t(speed + double(rng() % 200));
+    std::sort(values.begin(), values.end());
+    brick.attributes.insert(brick.attributes.end(), values.begin(), values.end());
   }
+  const std::size_t plain = encodeBrick(brick, 1, AttributeCoding::Values).size();
+  const std::size_t coded = encodeBrick(brick, 1, AttributeCoding::CellDeltas).size();
+  EXPECT_LT(2 * coded, plain) << coded << " bytes coded, " << plain << " as they are";
 }
 
 TEST(BrickCodec, EncodingIntoAKeptBufferGivesTheSamePayload) {
@@ -178,13 +239,15 @@ TEST(StoreHeader, NamesAnUnknownVersion) {
   StoreHeader h;
   h.cellSize = 1;
   h.brickGrid = {1, 1, 1};
-  h.version = 7;
+  h.version = kStoreVersion + 1;
   auto bytes = serializeStoreHeader(h);
   try {
     parseStoreHeader(bytes, "s/store.fsh");
     FAIL();
   } catch (const FileError& e) {
-    EXPECT_NE(std::string(e.what()).find("unsupported store version 7"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("unsupported store version " + std::to_string(kStoreVersion + 1)),
+              std::string::npos)
+        << e.what();
   }
 }
 

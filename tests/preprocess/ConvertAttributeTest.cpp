@@ -246,6 +246,19 @@ TEST(ConvertAttribute, VersionThreeStoresAreReadAndAppendedToAsVersionThree) {
   EXPECT_EQ(range->min, std::min(back.frame(0)->stats.attributeMin, back.frame(3)->stats.attributeMin));
   EXPECT_EQ(range->max, std::max(back.frame(0)->stats.attributeMax, back.frame(3)->stats.attributeMax));
   EXPECT_EQ(storedValues(back, 3).size(), 40u);
+  // Its payloads lay the values out as version 3 did (AttributeCoding::Values), not as this
+  // version does.
+  const auto index = back.frame(3);
+  for (std::uint32_t b = 0; b < index->bricks.size(); ++b) {
+    const UninitializedVector<std::byte> payload = back.readPayload(*index, b);
+    const DecodedBrick read = back.readBrick(*index, b);
+    const auto decode = [&](AttributeCoding coding) {
+      return decodeBrick(payload, "f", b, index->bricks[b], back.header().cellsPerBrick(), true, false, true, coding)
+          .attributes;
+    };
+    EXPECT_EQ(decode(AttributeCoding::Values), read.attributes);
+    EXPECT_NE(decode(AttributeCoding::CellDeltas), read.attributes);
+  }
   // A version 3 frame file in a store of this version is refused, naming both versions.
   StoreHeader current = header;
   current.version = kStoreVersion;

@@ -265,23 +265,45 @@ std::uint64_t framePayloadsAndIndex(const BrickStore& store, int frame) {
   return checksum64(bytes.data(), bytes.size() - footer);
 }
 
+/// convert(inputs) into a store at `dir` of `header` but for its version, which is `version`.
+void convertIntoVersion(const std::vector<FrameInput>& inputs, StoreHeader header, std::uint32_t version,
+                        const fs::path& dir, ConvertOptions options) {
+  header.version = version;
+  header.id = randomStoreId();
+  fs::create_directories(dir);
+  const auto bytes = serializeStoreHeader(header);
+  testing::writeBytes(dir / kStoreHeaderName, std::string(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+  options.append = true;  // into the store without frames, not a new one
+  convert(inputs, dir, options);
+  ASSERT_EQ(BrickStore::open(dir).header().version, version);
+}
+
 TEST(ConvertKinds, FlipOnlyFrameHasNoKindsAndTheBytesOfBefore) {
   testing::TempDir dir("kinds-flip");
-  convert({{30, {kFlip30}}}, dir / "store", silent());
+  const std::vector<FrameInput> flip{{30, {kFlip30}}};
+  convert(flip, dir / "store", silent());
   const BrickStore store = BrickStore::open(dir / "store");
   EXPECT_FALSE(store.header().particleKinds);
   EXPECT_EQ(store.frame(30)->stats.kindCells, (std::array<std::uint64_t, kParticleKindCount>{}));
   EXPECT_TRUE(store.readBrick(*store.frame(30), 0).kinds.empty());
-  // What flipscope wrote before particle kinds (version 4, commit a6329ec, the same default
-  // `convert`), checksummed in the same way: all but the footer, which grew by the kind counts.
-  EXPECT_EQ(framePayloadsAndIndex(store, 30), 4298729064305623437ull);
+  // What this version writes (7: the FLIP file's speed coded as deltas), checksummed over all
+  // but the footer.
+  EXPECT_EQ(framePayloadsAndIndex(store, 30), 13144045917115703811ull);
+  // Into a version 6 store, what flipscope wrote before particle kinds (version 4, commit
+  // a6329ec, the same default `convert`), checksummed in the same way: all but the footer,
+  // which grew by the kind counts.
+  convertIntoVersion(flip, store.header(), 6, dir / "v6", silent());
+  EXPECT_EQ(framePayloadsAndIndex(BrickStore::open(dir / "v6"), 30), 4298729064305623437ull);
   // The FLIP and secondary files with --kind-attribute none: the same too.
   ConvertOptions none = silent();
   none.kindAttribute = "none";
-  convert({{30, {kFlip30, kSecondary30}}}, dir / "none", none);
-  const BrickStore pair = BrickStore::open(dir / "none");
-  EXPECT_FALSE(pair.header().particleKinds);
-  EXPECT_EQ(framePayloadsAndIndex(pair, 30), 5215621096355647369ull);
+  const std::vector<FrameInput> pair{{30, {kFlip30, kSecondary30}}};
+  convert(pair, dir / "none", none);
+  const BrickStore both = BrickStore::open(dir / "none");
+  EXPECT_FALSE(both.header().particleKinds);
+  EXPECT_EQ(framePayloadsAndIndex(both, 30), 16379238223709756725ull);
+  convertIntoVersion(pair, both.header(), 6, dir / "none-v6", none);
+  EXPECT_EQ(framePayloadsAndIndex(BrickStore::open(dir / "none-v6"), 30), 5215621096355647369ull);
 }
 
 TEST(ConvertKinds, OutOfCoreGivesTheStoreOfInCore) {

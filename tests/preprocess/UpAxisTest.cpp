@@ -52,7 +52,7 @@ TEST(UpAxis, ConvertRecordsTheFilesAxisOrTheOneAskedFor) {
   EXPECT_EQ(report.header.upAxis, UpAxis::Z);
   EXPECT_NE(report.upAxisOrigin.find("fluid_data_0030.vdb"), std::string::npos) << report.upAxisOrigin;
   EXPECT_EQ(BrickStore::open(dir / "dam").header().upAxis, UpAxis::Z);
-  EXPECT_EQ(BrickStore::open(dir / "dam").header().version, 6u);
+  EXPECT_EQ(BrickStore::open(dir / "dam").header().version, kStoreVersion);
 
   const fs::path ply = writePly(dir / "a.ply");
   EXPECT_EQ(convert({{0, {ply}}}, dir / "plain", quiet()).header.upAxis, UpAxis::Unknown);
@@ -86,7 +86,9 @@ TEST(UpAxis, AnAppendKeepsTheStoresAxisAndRefusesAnother) {
     convert({{2, {ply}}}, dir / "store", options);
     FAIL() << "appended with another up axis";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("records z up (store version 6), not y (--up)"), std::string::npos)
+    EXPECT_NE(
+        std::string(e.what()).find("records z up (store version " + std::to_string(kStoreVersion) + "), not y (--up)"),
+        std::string::npos)
         << e.what();
   }
   EXPECT_EQ(BrickStore::open(dir / "store").frames(), (std::vector<int>{0, 1}));

@@ -61,7 +61,7 @@ TEST_F(AttributeCli, ConvertStoresTheNamedAttributeAndInfoShowsItsNameAndRange) 
   const auto j = nlohmann::json::parse(info.output);
   EXPECT_EQ(j["attribute"], "temperature");
   EXPECT_EQ(j["attribute_kind"], "scalar");
-  EXPECT_EQ(j["version"].get<std::uint32_t>(), 6u);
+  EXPECT_EQ(j["version"].get<std::uint32_t>(), 7u);
   const float lo = temperatureAt(0.0125f), hi = temperatureAt(0.025f * 39 + 0.0125f);
   ASSERT_TRUE(j["attribute_range"].is_array()) << info.output;
   EXPECT_EQ(j["attribute_range"][0].get<float>(), lo);

@@ -86,7 +86,7 @@ TEST_F(Cli, DefaultConvertOfMantaflowMakesOneCellPerParticleSpacingAndInfoShowsI
   EXPECT_LT(spacing, 0.05);
   EXPECT_EQ(spacing, j["cell_size"].get<double>());
   EXPECT_DOUBLE_EQ(j["particle_spacing_cells"].get<double>(), 1.0);
-  EXPECT_EQ(j["version"].get<std::uint32_t>(), 6u);
+  EXPECT_EQ(j["version"].get<std::uint32_t>(), 7u);
   EXPECT_EQ(j["particle_kinds"], false) << "a FLIP file alone";
 
   CommandRun text = runFlipscope("info " + path("store"));
