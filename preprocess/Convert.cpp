@@ -70,7 +70,11 @@ void stopPoint(const char* point) {
 struct MemoryPlan {
   explicit MemoryPlan(std::uint64_t budget, bool separateValues) {
     const std::uint64_t perParticle = separateValues ? 12 : 8;  // key (+ value): binning sorts in place
-    chunkParticles = std::clamp<std::uint64_t>(budget / 256 / 24, 4096, 1 << 20);
+    // At most 256 Ki particles a chunk (6 MiB of positions and velocities; two chunks are in
+    // flight with read-ahead): the 20 M particle PLY of `bench render --peer embree` converted in
+    // 0.67-0.70 s with chunks of 256 Ki, 0.69-0.71 s with 512 Ki, 0.70-1.00 s with 1 Mi (their
+    // first touch) and 0.69-0.76 s with 64 Ki (the passes a chunk), alternating runs.
+    chunkParticles = std::clamp<std::uint64_t>(budget / 256 / 24, 4096, 1 << 18);
     maxBinParticles = std::max<std::uint64_t>(budget * 6 / 10 / perParticle, 1 << 16);
     // An eighth of the budget buffers the spill files: up to 256 of up to 1 MiB (direct writes of
     // 64 KiB ran at half the disk's speed of 1 MiB ones here).
