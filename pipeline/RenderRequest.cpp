@@ -37,4 +37,10 @@ Camera defaultRenderCamera(BrickSource& source, int first, int last, std::uint32
   }
 }
 
+std::string framingNote(std::uint64_t particlesLeftOut, bool flipbook) {
+  return "the camera frames the liquid and leaves out " + std::string(flipbook ? "up to " : "") +
+         std::to_string(particlesLeftOut) + " particle" + (particlesLeftOut == 1 ? "" : "s") +
+         (flipbook ? " a frame" : "") + " far from it (give --camera or --camera-file to frame them)";
+}
+
 }  // namespace flipscope

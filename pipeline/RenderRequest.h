@@ -5,6 +5,7 @@
 #pragma once
 
 #include <optional>
+#include <string>
 
 #include <glm/vec3.hpp>
 
@@ -47,5 +48,9 @@ ResolvedRender resolve(const RenderRequest& request, const BrickStore& store);
 /// they hold no brick. Throws FileError naming the source when no camera can frame it.
 Camera defaultRenderCamera(BrickSource& source, int first, int last, std::uint32_t width, std::uint32_t height,
                            glm::dvec3 up, std::uint64_t* particlesLeftOut = nullptr);
+
+/// What to tell a user whose default camera left out `particlesLeftOut` (> 0) particles far from
+/// the liquid (in one frame, or the most in any frame of a flipbook).
+std::string framingNote(std::uint64_t particlesLeftOut, bool flipbook);
 
 }  // namespace flipscope

@@ -34,9 +34,12 @@ namespace {
 
 using FrameIndices = std::vector<std::shared_ptr<const FrameIndex>>;
 
+/// The indices of the frames of `source` in [first, last]: a flipbook's range may span frames
+/// the store lacks.
 FrameIndices frameIndices(BrickSource& source, int first, int last) {
   FrameIndices frames;
-  for (int f = first; f <= last; ++f) frames.push_back(source.frame(f));
+  for (const int f : source.frames())
+    if (f >= first && f <= last) frames.push_back(source.frame(f));
   return frames;
 }
 
@@ -138,9 +141,12 @@ FramedBounds framedBounds(BrickSource& source, int first, int last) {
     windowLo[a] = bulkLo[a] - std::min(bulkLo[a], extent);
     windowHi[a] = bulkHi[a] + extent;
   }
-  for (const auto& index : frames)
+  for (const auto& index : frames) {
+    std::uint64_t leftOut = 0;
     for (const BrickRecord& record : index->bricks)
-      if (!within(record.coord, windowLo, windowHi)) out.particlesLeftOut += record.particles;
+      if (!within(record.coord, windowLo, windowHi)) leftOut += record.particles;
+    out.particlesLeftOut = std::max(out.particlesLeftOut, leftOut);
+  }
   out.box = occupiedBoundsWithin(source, frames, windowLo, windowHi);
   return out;
 }

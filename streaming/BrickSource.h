@@ -102,15 +102,15 @@ class StoreBrickSource : public BrickSource {
   bool mAttributes;
 };
 
-/// World box of the occupied cells of frames [first, last] of `source` (empty box when they hold
-/// no brick). Cell-exact from the bricks on the outer layers, or brick-exact when more than a
+/// World box of the occupied cells of frames [first, last] of `source` (those it has; empty box
+/// when they hold no brick). Cell-exact from the bricks on the outer layers, or brick-exact when more than a
 /// few thousand bricks form them across the range.
 Box occupiedBounds(BrickSource& source, int first, int last);
 
 /// What a default camera frames (framedBounds): the occupied cells, less particles far away.
 struct FramedBounds {
   Box box;                             ///< as occupiedBounds, over the bricks kept
-  std::uint64_t particlesLeftOut = 0;  ///< of the bricks left out, over all frames of the range
+  std::uint64_t particlesLeftOut = 0;  ///< of the bricks left out, the most in any one frame
   std::uint64_t particles = 0;         ///< of every brick, over all frames of the range
 };
 
@@ -120,8 +120,10 @@ struct FramedBounds {
 /// brick is kept when, along every axis, it lies within the bulk's longest extent of the bulk.
 /// So spray and splashes within a tank's size of the liquid are framed, and the few particles a
 /// solver flung ten thousand tank sizes away (whose bricks the domain then holds) are not, where
-/// framing them would leave the liquid a speck.
+/// framing them would leave the liquid a speck. Below 1 / kFramingTail particles over the range
+/// the tails are empty: nothing is left out. Frames of the range the source lacks are skipped.
 FramedBounds framedBounds(BrickSource& source, int first, int last);
 inline constexpr double kFramingTail = 5e-4;
+static_assert(kFramingTail < 0.5, "the tails at both ends leave a bulk");
 
 }  // namespace flipscope

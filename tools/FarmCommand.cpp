@@ -13,6 +13,7 @@
 
 #include "core/Error.h"
 #include "core/NumberText.h"
+#include "pipeline/RenderRequest.h"
 #include "preprocess/Convert.h"
 #include "preprocess/particles/InputSequence.h"
 #include "preprocess/store/StoreInspection.h"
@@ -298,7 +299,11 @@ void runFarmRender(const RenderFarmArgs& a, const std::vector<std::string>& extr
     } else {
       StoreBrickSource source(opened);
       const UpAxis up = parseUpAxis("--up", a.up).value_or(opened.header().upAxis);
-      camera = defaultRenderCamera(source, plan.frames.front(), plan.frames.back(), width, height, upAxisVector(up));
+      std::uint64_t leftOut = 0;
+      camera = defaultRenderCamera(source, plan.frames.front(), plan.frames.back(), width, height, upAxisVector(up),
+                                   &leftOut);
+      if (leftOut > 0)
+        std::printf("farm render: %s\n", framingNote(leftOut, plan.frames.front() != plan.frames.back()).c_str());
     }
     if (!a.farm.dryRun) {
       fs::create_directories(farmDir);

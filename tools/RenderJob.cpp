@@ -83,11 +83,7 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
   } else {
     std::uint64_t leftOut = 0;
     camera = defaultRenderCamera(renderer.source(), first, last, settings.width, settings.height, surface.up, &leftOut);
-    if (leftOut > 0 && !job.quiet)
-      std::printf(
-          "render: the camera frames the liquid and leaves out %llu particle%s far from it (give "
-          "--camera or --camera-file to frame them)\n",
-          (unsigned long long)leftOut, leftOut == 1 ? "" : "s");
+    if (leftOut > 0 && !job.quiet) std::printf("render: %s\n", framingNote(leftOut, last > first).c_str());
   }
   if (!job.saveCamera.empty()) saveCamera(job.saveCamera, camera);
 

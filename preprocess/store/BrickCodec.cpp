@@ -224,7 +224,7 @@ void decompressPrefix(std::span<const std::byte> payload, std::vector<std::byte>
 
 DecodedBrick decodeBrick(std::span<const std::byte> payload, const std::filesystem::path& file,
                          std::uint32_t brickIndex, const BrickRecord& expected, std::uint32_t cellsPerBrick,
-                         bool hasAttribute, bool hasKinds, bool readAttributes, AttributeCoding coding) {
+                         bool hasAttribute, bool hasKinds, AttributeCoding coding, bool readAttributes) {
   const std::string where = "brick " + std::to_string(brickIndex);
   auto fail = [&](const std::string& reason) -> FileError { return FileError(file, where + ": " + reason); };
 

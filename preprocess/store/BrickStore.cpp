@@ -714,8 +714,8 @@ UninitializedVector<std::byte> BrickStore::readPayload(const FrameIndex& frame, 
 DecodedBrick BrickStore::readBrick(const FrameIndex& frame, std::uint32_t brickIndex, bool attributes) const {
   auto payload = readPayload(frame, brickIndex);
   return decodeBrick(payload, frame.file, brickIndex, frame.bricks[brickIndex], mHeader.cellsPerBrick(),
-                     mHeader.attribute != AttributeKind::None, mHeader.particleKinds, attributes,
-                     attributeCodingOf(mHeader.version));
+                     mHeader.attribute != AttributeKind::None, mHeader.particleKinds,
+                     attributeCodingOf(mHeader.version), attributes);
 }
 
 }  // namespace flipscope

@@ -173,14 +173,17 @@ inline constexpr AttributeCoding attributeCodingOf(std::uint32_t storeVersion) {
   return storeVersion >= 7 ? AttributeCoding::CellDeltas : AttributeCoding::Values;
 }
 
+/// The coding this version writes.
+inline constexpr AttributeCoding kAttributeCoding = attributeCodingOf(kStoreVersion);
+
 /// Payload codec (exposed for tests and the streaming benchmark); `coding` is the store
-/// version's (attributeCodingOf).
-std::vector<std::byte> encodeBrick(const DecodedBrick& brick, int zstdLevel,
-                                   AttributeCoding coding = attributeCodingOf(kStoreVersion));
+/// version's (attributeCodingOf): no default, so that no caller codes an older store's payloads
+/// as this version's.
+std::vector<std::byte> encodeBrick(const DecodedBrick& brick, int zstdLevel, AttributeCoding coding);
 /// encodeBrick into `payload`, whose capacity is reused: binning recycles a few payload
 /// buffers, where a fresh one per brick cost a first touch of every payload page.
 void encodeBrickInto(const DecodedBrick& brick, int zstdLevel, UninitializedVector<std::byte>& payload,
-                     AttributeCoding coding = attributeCodingOf(kStoreVersion));
+                     AttributeCoding coding);
 /// Throws FileError naming `file` and `brickIndex` on any malformation; checks `expected`
 /// particle and cell counts, that every cell index is < cellsPerBrick and, with `hasKinds`,
 /// that every kind is < kParticleKindCount. Without `readAttributes`, a payload's attribute
@@ -188,8 +191,7 @@ void encodeBrickInto(const DecodedBrick& brick, int zstdLevel, UninitializedVect
 /// are decompressed and checked (a render that shows no attribute; most of a payload's bytes).
 DecodedBrick decodeBrick(std::span<const std::byte> payload, const std::filesystem::path& file,
                          std::uint32_t brickIndex, const BrickRecord& expected, std::uint32_t cellsPerBrick,
-                         bool hasAttribute, bool hasKinds, bool readAttributes = true,
-                         AttributeCoding coding = attributeCodingOf(kStoreVersion));
+                         bool hasAttribute, bool hasKinds, AttributeCoding coding, bool readAttributes = true);
 
 class BrickStore {
  public:

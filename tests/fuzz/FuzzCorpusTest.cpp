@@ -268,9 +268,18 @@ TEST(FuzzCorpus, Write) {
   // And Blender Mantaflow's FLIP and secondary files: a store with particle kinds.
   const std::string flipAndSecondary = "'" + (mantaflow.parent_path() / "data" / "fluid_data_0030.vdb").string() +
                                        "' '" + (mantaflow / "fluid_particles_0030.vdb").string() + "'";
+  // A version 6 store too (its attribute values as they are, AttributeCoding::Values): the
+  // header of speed32 at version 6, appended to.
   for (const Store& store : {Store{"speed32", "s.ply --resolution 24 --brick-size 32"},
                              Store{"none64", "s.ply --resolution 48 --brick-size 64 --attribute none"},
-                             Store{"kinds32", flipAndSecondary + " --resolution 24 --brick-size 32 --attribute none"}}) {
+                             Store{"kinds32", flipAndSecondary + " --resolution 24 --brick-size 32 --attribute none"},
+                             Store{"speed32_v6", "s.ply --append"}}) {
+    if (std::string(store.name) == "speed32_v6") {
+      StoreHeader v6 = parseStoreHeader(bytesOf(tmp / "speed32" / kStoreHeaderName), "speed32");
+      v6.version = 6;
+      fs::create_directories(tmp / store.name);
+      writeSeed(tmp / store.name / kStoreHeaderName, serializeStoreHeader(v6));
+    }
     const auto run =
         testing::runFlipscope("convert " + store.options + " -o " + store.name + " -q", tmp.path());
     ASSERT_EQ(run.exitCode, 0) << run.output;

@@ -204,8 +204,7 @@ inline Result frameIndex(std::span<const std::byte> input) {
         const BrickRecord& b = index.bricks[i];
         try {
           decodeBrick(bytes.subspan(b.offset, b.bytes), "frame", i, b, header.cellsPerBrick(),
-                      header.attribute != AttributeKind::None, header.particleKinds, true,
-                      attributeCodingOf(header.version));
+                      header.attribute != AttributeKind::None, header.particleKinds, attributeCodingOf(header.version));
         } catch (const FileError&) {
         }
       }
@@ -240,7 +239,7 @@ inline Result brickPayload(std::span<const std::byte> input) {
   std::optional<DecodedBrick> streams;
   try {
     streams =
-        decodeBrick(payload, "brick", 0, record, brickSize * brickSize * brickSize, attribute, kinds, false, coding);
+        decodeBrick(payload, "brick", 0, record, brickSize * brickSize * brickSize, attribute, kinds, coding, false);
     if (streams->particleCount() != record.particles || streams->cells.size() != record.cells ||
         !streams->attributes.empty())
       throw LogicError("decodeBrick without attributes accepted a brick that does not match its record");
@@ -248,14 +247,14 @@ inline Result brickPayload(std::span<const std::byte> input) {
   }
   try {
     const DecodedBrick brick =
-        decodeBrick(payload, "brick", 0, record, brickSize * brickSize * brickSize, attribute, kinds, true, coding);
+        decodeBrick(payload, "brick", 0, record, brickSize * brickSize * brickSize, attribute, kinds, coding);
     if (brick.particleCount() != record.particles || brick.cells.size() != record.cells)
       throw LogicError("decodeBrick accepted a brick that does not match its record");
     if (!streams || streams->cells != brick.cells || streams->counts != brick.counts || streams->kinds != brick.kinds)
       throw LogicError("a brick decodes differently without its attributes");
     // What decodes must encode to the same brick.
     const DecodedBrick again = decodeBrick(encodeBrick(brick, 1, coding), "brick", 0, record,
-                                           brickSize * brickSize * brickSize, attribute, kinds, true, coding);
+                                           brickSize * brickSize * brickSize, attribute, kinds, coding);
     if (again.cells != brick.cells || again.counts != brick.counts || again.attributes != brick.attributes ||
         again.kinds != brick.kinds)
       throw LogicError("encodeBrick(decodeBrick(payload)) decodes differently");

@@ -30,7 +30,7 @@ BrickRecord record(std::uint32_t cells, std::uint32_t particles) {
 
 void expectRefused(const std::vector<std::byte>& payload, const BrickRecord& r, const std::string& part) {
   try {
-    decodeBrick(payload, "f.fsf", 3, r, 32 * 32 * 32, false, false);
+    decodeBrick(payload, "f.fsf", 3, r, 32 * 32 * 32, false, false, kAttributeCoding);
     ADD_FAILURE() << "accepted; expected a FileError mentioning " << part;
   } catch (const FileError& e) {
     EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
@@ -83,16 +83,16 @@ TEST(BrickCodecDamage, DeclaredSizeBeyondTheFrameIsRefusedCheaply) {
   std::memcpy(payload.data() + 5 + ((descriptor & 0x20) ? 0 : 1), &huge, 4);
   ASSERT_EQ(ZSTD_getFrameContentSize(payload.data(), payload.size()), huge);
   try {
-    decodeBrick(payload, "f.fsf", 0, record(1, 1u << 29), 32 * 32 * 32, true, false);
+    decodeBrick(payload, "f.fsf", 0, record(1, 1u << 29), 32 * 32 * 32, true, false, kAttributeCoding);
     ADD_FAILURE() << "accepted";
   } catch (const FileError& e) {
     EXPECT_NE(std::string(e.what()).find("f.fsf"), std::string::npos) << e.what();
   }
   // The same frame with its true size decodes (its values as versions 3 to 6 lay them out).
   const std::vector<std::byte> good = compress(raw);
-  EXPECT_EQ(decodeBrick(good, "f.fsf", 0, record(1, 1u << 16), 32 * 32 * 32, true, false, true, AttributeCoding::Values)
-                .attributes,
-            attributes);
+  EXPECT_EQ(
+      decodeBrick(good, "f.fsf", 0, record(1, 1u << 16), 32 * 32 * 32, true, false, AttributeCoding::Values).attributes,
+      attributes);
 }
 
 }  // namespace

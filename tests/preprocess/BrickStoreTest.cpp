@@ -54,7 +54,7 @@ TEST(BrickCodec, RoundTripsRandomBricks) {
       BrickRecord r;
       r.cells = std::uint32_t(brick.cells.size());
       r.particles = std::uint32_t(brick.particleCount());
-      DecodedBrick back = decodeBrick(payload, "x.fsf", 3, r, 64 * 64 * 64, attribute, false, true, coding);
+      DecodedBrick back = decodeBrick(payload, "x.fsf", 3, r, 64 * 64 * 64, attribute, false, coding);
       EXPECT_EQ(back.cells, brick.cells);
       EXPECT_EQ(back.counts, brick.counts);
       EXPECT_EQ(back.attributes, brick.attributes);
@@ -126,8 +126,8 @@ TEST(BrickCodec, EncodingIntoAKeptBufferGivesTheSamePayload) {
   for (int i = 0; i < 20; ++i) {
     const std::size_t before = kept.size();
     const DecodedBrick brick = randomBrick(rng, 64 * 64 * 64, i % 3 != 0);
-    encodeBrickInto(brick, 1, kept);
-    const std::vector<std::byte> fresh = encodeBrick(brick, 1);
+    encodeBrickInto(brick, 1, kept, kAttributeCoding);
+    const std::vector<std::byte> fresh = encodeBrick(brick, 1, kAttributeCoding);
     ASSERT_EQ(std::vector<std::byte>(kept.begin(), kept.end()), fresh) << "brick " << i;
     shrank = shrank || (i > 0 && fresh.size() < before);
   }
@@ -149,11 +149,12 @@ TEST(BrickCodec, DecodingWithoutAttributesLeavesThemOutAndKeepsTheRest) {
           if (attribute)
             for (std::uint32_t i = 0; i < brick.counts.back(); ++i) brick.attributes.push_back(std::uint16_t(rng()));
         }
-        const std::vector<std::byte> payload = encodeBrick(brick, 1);
+        const std::vector<std::byte> payload = encodeBrick(brick, 1, kAttributeCoding);
         BrickRecord r;
         r.cells = std::uint32_t(brick.cells.size());
         r.particles = std::uint32_t(brick.particleCount());
-        const DecodedBrick back = decodeBrick(payload, "x.fsf", 3, r, 64 * 64 * 64, attribute, kinds, false);
+        const DecodedBrick back =
+            decodeBrick(payload, "x.fsf", 3, r, 64 * 64 * 64, attribute, kinds, kAttributeCoding, false);
         EXPECT_EQ(back.cells, brick.cells) << cells << " cells";
         EXPECT_EQ(back.counts, brick.counts);
         EXPECT_EQ(back.kinds, brick.kinds);
@@ -162,11 +163,13 @@ TEST(BrickCodec, DecodingWithoutAttributesLeavesThemOutAndKeepsTheRest) {
         // the table does not hold, and a payload cut inside them, are errors.
         BrickRecord more = r;
         ++more.particles;
-        EXPECT_THROW(decodeBrick(payload, "x.fsf", 3, more, 64 * 64 * 64, attribute, kinds, false), FileError);
+        EXPECT_THROW(decodeBrick(payload, "x.fsf", 3, more, 64 * 64 * 64, attribute, kinds, kAttributeCoding, false),
+                     FileError);
         DecodedBrick streams = brick;  // the payload's bytes before the attributes: about these
         streams.attributes.clear();
-        const std::span<const std::byte> cut(payload.data(), encodeBrick(streams, 1).size() / 2);
-        EXPECT_THROW(decodeBrick(cut, "x.fsf", 3, r, 64 * 64 * 64, attribute, kinds, false), FileError);
+        const std::span<const std::byte> cut(payload.data(), encodeBrick(streams, 1, kAttributeCoding).size() / 2);
+        EXPECT_THROW(decodeBrick(cut, "x.fsf", 3, r, 64 * 64 * 64, attribute, kinds, kAttributeCoding, false),
+                     FileError);
       }
 }
 
@@ -180,7 +183,8 @@ TEST(BrickCodec, APayloadTooShortForItsAttributesIsRefusedWithoutThem) {
   r.cells = 3;
   r.particles = 1200;
   try {
-    decodeBrick(encodeBrick(brick, 1), "x.fsf", 4, r, 64 * 64 * 64, true, false, false);
+    decodeBrick(encodeBrick(brick, 1, kAttributeCoding), "x.fsf", 4, r, 64 * 64 * 64, true, false, kAttributeCoding,
+                false);
     ADD_FAILURE() << "decoded";
   } catch (const FileError& e) {
     EXPECT_NE(std::string(e.what()).find("fewer than its 1200 attribute values take"), std::string::npos) << e.what();
@@ -191,18 +195,18 @@ TEST(BrickCodec, APayloadTooShortForItsAttributesIsRefusedWithoutThem) {
 TEST(BrickCodec, RejectsWrongCountsAndGarbage) {
   std::mt19937 rng(5);
   DecodedBrick brick = randomBrick(rng, 32 * 32 * 32, false);
-  auto payload = encodeBrick(brick, 1);
+  auto payload = encodeBrick(brick, 1, kAttributeCoding);
   BrickRecord r;
   r.cells = std::uint32_t(brick.cells.size());
   r.particles = std::uint32_t(brick.particleCount()) + 1;
   try {
-    decodeBrick(payload, "f.fsf", 9, r, 32 * 32 * 32, false, false);
+    decodeBrick(payload, "f.fsf", 9, r, 32 * 32 * 32, false, false, kAttributeCoding);
     FAIL() << "accepted a wrong particle count";
   } catch (const FileError& e) {
     EXPECT_NE(std::string(e.what()).find("f.fsf: brick 9"), std::string::npos) << e.what();
   }
   std::vector<std::byte> garbage(64, std::byte{0x5a});
-  EXPECT_THROW(decodeBrick(garbage, "f.fsf", 0, r, 32 * 32 * 32, false, false), FileError);
+  EXPECT_THROW(decodeBrick(garbage, "f.fsf", 0, r, 32 * 32 * 32, false, false, kAttributeCoding), FileError);
 }
 
 TEST(StoreHeader, RoundTripsAndRejectsEveryCorruption) {

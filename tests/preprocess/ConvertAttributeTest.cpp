@@ -253,7 +253,7 @@ TEST(ConvertAttribute, VersionThreeStoresAreReadAndAppendedToAsVersionThree) {
     const UninitializedVector<std::byte> payload = back.readPayload(*index, b);
     const DecodedBrick read = back.readBrick(*index, b);
     const auto decode = [&](AttributeCoding coding) {
-      return decodeBrick(payload, "f", b, index->bricks[b], back.header().cellsPerBrick(), true, false, true, coding)
+      return decodeBrick(payload, "f", b, index->bricks[b], back.header().cellsPerBrick(), true, false, coding)
           .attributes;
     };
     EXPECT_EQ(decode(AttributeCoding::Values), read.attributes);

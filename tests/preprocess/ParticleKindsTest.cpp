@@ -74,19 +74,23 @@ TEST(BrickCodecKinds, RoundTripsRandomBricksWithKinds) {
   for (int i = 0; i < 40; ++i) {
     const bool attribute = i % 2;
     const DecodedBrick brick = randomKindBrick(rng, 64 * 64 * 64, attribute);
-    const auto payload = encodeBrick(brick, 1);
-    const DecodedBrick back = decodeBrick(payload, "x.fsf", 3, recordOf(brick), 64 * 64 * 64, attribute, true);
+    const auto payload = encodeBrick(brick, 1, kAttributeCoding);
+    const DecodedBrick back =
+        decodeBrick(payload, "x.fsf", 3, recordOf(brick), 64 * 64 * 64, attribute, true, kAttributeCoding);
     EXPECT_EQ(back.cells, brick.cells);
     EXPECT_EQ(back.counts, brick.counts);
     EXPECT_EQ(back.attributes, brick.attributes);
     EXPECT_EQ(back.kinds, brick.kinds);
     // Read as a store without kinds, the kinds are trailing bytes (or misread attributes).
-    EXPECT_THROW(decodeBrick(payload, "x.fsf", 3, recordOf(brick), 64 * 64 * 64, attribute, false), FileError);
+    EXPECT_THROW(decodeBrick(payload, "x.fsf", 3, recordOf(brick), 64 * 64 * 64, attribute, false, kAttributeCoding),
+                 FileError);
   }
   // A brick without kinds, read as one with them, is too short.
   DecodedBrick plain = randomKindBrick(rng, 32 * 32 * 32, false);
   plain.kinds.clear();
-  EXPECT_THROW(decodeBrick(encodeBrick(plain, 1), "x.fsf", 0, recordOf(plain), 32 * 32 * 32, false, true), FileError);
+  EXPECT_THROW(decodeBrick(encodeBrick(plain, 1, kAttributeCoding), "x.fsf", 0, recordOf(plain), 32 * 32 * 32, false,
+                           true, kAttributeCoding),
+               FileError);
 }
 
 std::vector<std::byte> compress(const ByteWriter& raw) {
@@ -112,7 +116,7 @@ void expectRefused(const std::vector<std::byte>& payload, const std::string& par
   r.cells = 2;
   r.particles = 2;
   try {
-    decodeBrick(payload, "f.fsf", 7, r, 32 * 32 * 32, false, true);
+    decodeBrick(payload, "f.fsf", 7, r, 32 * 32 * 32, false, true, kAttributeCoding);
     ADD_FAILURE() << "accepted; expected a FileError mentioning " << part;
   } catch (const FileError& e) {
     EXPECT_NE(std::string(e.what()).find("f.fsf"), std::string::npos) << e.what();
@@ -125,7 +129,8 @@ TEST(BrickCodecKinds, RefusesKindsOutsideTheFourAndWrongLengths) {
   BrickRecord r;
   r.cells = 2;
   r.particles = 2;
-  const DecodedBrick good = decodeBrick(twoCellPayload({0, 3}), "f.fsf", 7, r, 32 * 32 * 32, false, true);
+  const DecodedBrick good =
+      decodeBrick(twoCellPayload({0, 3}), "f.fsf", 7, r, 32 * 32 * 32, false, true, kAttributeCoding);
   EXPECT_EQ(good.kinds, (std::vector<ParticleKind>{ParticleKind::Liquid, ParticleKind::Bubble}));
   expectRefused(twoCellPayload({0, 4}), "cell 5 has particle kind 4");
   expectRefused(twoCellPayload({255, 0}), "cell 0 has particle kind 255");

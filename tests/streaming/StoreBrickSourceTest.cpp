@@ -41,7 +41,7 @@ class StoreBrickSourceTest : public ::testing::Test {
       auto brick = mSynthetic.read({1, c});
       if (!brick) continue;
       writer.addBrick(c, std::uint32_t(brick->particleCount()), std::uint32_t(brick->cells.size()),
-                      encodeBrick(*brick, 1));
+                      encodeBrick(*brick, 1, kAttributeCoding));
       stats.particles += brick->particleCount();
     }
     writer.finish(stats);
@@ -79,16 +79,14 @@ struct CellsOfBrick {
   std::uint32_t particlesPerCell = 1;
 };
 
-/// Writes frame 0 of a store of bricks of 32 at `dir` (emptied first) holding `bricks`.
-void writeStore(const std::filesystem::path& dir, const StoreHeader& header, const std::vector<CellsOfBrick>& bricks) {
-  std::filesystem::remove_all(dir);
-  BrickStore store = BrickStore::createOrAppend(dir, header);
+/// Writes frame `frame` of `store` (bricks of 32) holding `bricks`.
+void writeFrame(BrickStore& store, int frame, const std::vector<CellsOfBrick>& bricks) {
   std::vector<const CellsOfBrick*> order;
   for (const CellsOfBrick& b : bricks) order.push_back(&b);
   std::sort(order.begin(), order.end(), [&](const CellsOfBrick* a, const CellsOfBrick* b) {
     return mortonEncode3(a->coord.x, a->coord.y, a->coord.z) < mortonEncode3(b->coord.x, b->coord.y, b->coord.z);
   });
-  FrameWriter writer(store.framePath(0), store.header(), 0);
+  FrameWriter writer(store.framePath(frame), store.header(), frame);
   FrameStats stats;
   for (const CellsOfBrick* b : order) {
     DecodedBrick brick;
@@ -96,11 +94,18 @@ void writeStore(const std::filesystem::path& dir, const StoreHeader& header, con
     std::sort(brick.cells.begin(), brick.cells.end());
     brick.counts.assign(brick.cells.size(), b->particlesPerCell);
     const auto particles = std::uint32_t(brick.cells.size()) * b->particlesPerCell;
-    writer.addBrick(b->coord, particles, std::uint32_t(brick.cells.size()), encodeBrick(brick, 1));
+    writer.addBrick(b->coord, particles, std::uint32_t(brick.cells.size()), encodeBrick(brick, 1, kAttributeCoding));
     stats.particles += particles;
   }
   writer.finish(stats);
-  store.addFrame(0);
+  store.addFrame(frame);
+}
+
+/// Writes frame 0 of a store of bricks of 32 at `dir` (emptied first) holding `bricks`.
+void writeStore(const std::filesystem::path& dir, const StoreHeader& header, const std::vector<CellsOfBrick>& bricks) {
+  std::filesystem::remove_all(dir);
+  BrickStore store = BrickStore::createOrAppend(dir, header);
+  writeFrame(store, 0, bricks);
 }
 
 std::filesystem::path testDirectory(const std::string& name) {
@@ -192,6 +197,25 @@ TEST(FramedBounds, LeaveOutAFewParticlesFarAwayAndKeepSprayNearAndManyFar) {
   f = framed({{{60, 0, 0}, {{0, 0, 0}}, 5}});
   EXPECT_EQ(f.particlesLeftOut, 0u);
   EXPECT_EQ(f.box.max.x, header.origin.x + (60 * 32 + 1) * header.cellSize);
+
+  // A flipbook over frames 0 to 4 of a store with frames 0 and 4 only, each with one particle
+  // flung far away (in another brick): both frames are framed, the frames between skipped, and
+  // one particle a frame is left out.
+  std::vector<CellsOfBrick> frame0 = bulk, frame4 = bulk;
+  frame0.push_back({{60, 0, 0}, {{1, 1, 1}}});
+  frame4.push_back({{61, 0, 0}, {{1, 1, 1}}});
+  frame4.push_back({{4, 0, 0}, {{30, 2, 2}}});  // within the bulk's extent: framed
+  writeStore(dir, header, frame0);
+  {
+    BrickStore store = BrickStore::createOrAppend(dir, header);
+    writeFrame(store, 4, frame4);
+  }
+  StoreBrickSource source(BrickStore::open(dir));
+  f = framedBounds(source, 0, 4);
+  EXPECT_EQ(f.particles, 2 * 8000u + 3);
+  EXPECT_EQ(f.particlesLeftOut, 1u) << "the most in one frame";
+  EXPECT_EQ(f.box.max.x, cellBox(header, {frame4.back()}).max.x);
+  EXPECT_EQ(occupiedBounds(source, 0, 4).max.x, cellBox(header, {frame4[frame4.size() - 2]}).max.x);
   std::filesystem::remove_all(dir);
 }
 
