@@ -757,10 +757,7 @@ SpacingEstimate neighbourSpacing(ParticleSource& source, std::size_t sampleSize,
   if (!(std::isfinite(median) && median > 0)) drawn.reset();
   const Sample sample = drawn ? std::move(*drawn) : reservoirSample(source, sampleSize, progress);
   SpacingEstimate e;
-  if (!sample.complete() && !sample.positions.empty()) {
-    e.sampledBounds.emplace();
-    for (const glm::vec3& p : sample.positions) e.sampledBounds->extend(glm::dvec3(p));
-  }
+  if (!sample.complete() && !sample.positions.empty()) e.sampledBounds = finiteBounds(sample.positions).bounds;
   if (sample.counted && sample.finite < kNeighbours + 1) {
     e.bounds = sample.bounds;
     e.origin = "too few particles to measure (" + std::to_string(sample.finite) + " finite)";

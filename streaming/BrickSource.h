@@ -103,8 +103,8 @@ class StoreBrickSource : public BrickSource {
 };
 
 /// World box of the occupied cells of frames [first, last] of `source` (those it has; empty box
-/// when they hold no brick). Cell-exact from the bricks on the outer layers, or brick-exact when more than a
-/// few thousand bricks form them across the range.
+/// when they hold no brick). Cell-exact from the bricks on the outer layers, or brick-exact when
+/// more than a few thousand bricks form them across the range.
 Box occupiedBounds(BrickSource& source, int first, int last);
 
 /// What a default camera frames (framedBounds): the occupied cells, less particles far away.
