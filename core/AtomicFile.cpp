@@ -43,9 +43,10 @@ void sleepBriefly() {
   ::nanosleep(&pause, nullptr);
 }
 
-/// Async-signal-safe: unlinks every registered file, then rmdirs every registered directory.
+/// Async-signal-safe: unlinks every registered file, then rmdirs every registered directory,
+/// twice: a directory registered before one inside it is empty only on the second pass.
 void removeRegistered() {
-  for (char kind : {'f', 'd'}) {
+  for (char kind : {'f', 'd', 'd'}) {
     for (Slot& slot : gSlots) {
       slot.readers.fetch_add(1);
       if (const char* entry = slot.path.load(); entry && entry[0] == kind) {

@@ -1,21 +1,31 @@
 // flipscope render: brick store frames -> EXR (R G B A Z unsmoothed.Z thickness N.*) or PNG
-// previews of the smoothed, shaded liquid surface, headless.
+// previews of the smoothed, shaded liquid surface, headless. Given particle files instead of a
+// store, it converts the frames it renders into a temporary store first (TemporaryStore), with
+// convert's defaults, and removes it after.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <cstdio>
+#include <filesystem>
 #include <memory>
+#include <optional>
 
 #include "core/Error.h"
+#include "core/Progress.h"
+#include "preprocess/Convert.h"
 #include "preprocess/particles/InputSequence.h"
+#include "tools/CliValues.h"
 #include "tools/Commands.h"
 #include "tools/RenderJob.h"
 #include "tools/RenderOptions.h"
+#include "tools/TemporaryStore.h"
 
 namespace flipscope::tools {
 namespace {
 
 struct RenderArgs {
-  std::string store;
+  std::vector<std::string> inputs;
+  std::string mem = "4G";
   std::string output;
   std::optional<int> frame;
   std::string frames;
@@ -23,15 +33,54 @@ struct RenderArgs {
   bool quiet = false;
 };
 
+/// A brick store directory: one input that is a directory.
+bool isStoreInput(const std::vector<std::string>& inputs) {
+  return inputs.size() == 1 && std::filesystem::is_directory(inputs.front());
+}
+
+/// Converts the frames of `inputs` that the render asks for (`range`; unset: the first frame
+/// found) into `store`, with convert's defaults and `memoryBudget`.
+void convertForRender(const std::vector<std::string>& inputs, std::optional<FrameRange> range,
+                      std::uint64_t memoryBudget, bool quiet, TemporaryStore& store) {
+  installCleanupSignalHandlers();  // the convert's temporaries, then the store, go on a signal
+  std::vector<FrameInput> frames = expandInputs(inputs, range);
+  if (!range && frames.size() > 1) frames.resize(1);
+  if (range && range->last > range->first && frames.size() == 1)
+    throw InputError("--frames " + std::to_string(range->first) + "-" + std::to_string(range->last) + ": the inputs " +
+                     "have no frame pattern (name_####.ext), so they are one frame; give --frame");
+  ConvertOptions options;
+  options.memoryBudget = memoryBudget;
+  options.progress = quiet ? Progress::Mode::Silent : Progress::Mode::Auto;
+  const std::string which =
+      frames.size() == 1 ? "frame " + std::to_string(frames.front().frame)
+                         : "frames " + std::to_string(frames.front().frame) + "-" + std::to_string(frames.back().frame);
+  if (!quiet)
+    std::printf(
+        "render: converting %s of the particle files into a temporary store (flipscope convert makes one "
+        "to keep)\n",
+        which.c_str());
+  std::fflush(stdout);
+  const ConvertReport report = convert(frames, store.store(), options);
+  store.hold();
+  for (const auto& warning : report.warnings) std::fprintf(stderr, "warning: %s\n", warning.c_str());
+  if (quiet) return;
+  std::uint64_t particles = 0;
+  double seconds = 0;
+  for (const FrameReport& f : report.frames) particles += f.stats.particles, seconds += f.seconds;
+  std::printf("render: converted %s particles in %.2f s; cell size %g (%s)\n",
+              Progress::humanCount(double(particles)).c_str(), seconds, report.header.cellSize,
+              report.cellSizeOrigin.c_str());
+}
+
 void runRender(const RenderArgs& a) {
   RenderJob job;
-  job.store = a.store;
   job.output = a.output;
-  if (a.frame) job.firstFrame = job.lastFrame = *a.frame;
-  if (!a.frames.empty()) {
-    const FrameRange range = parseFrameRange(a.frames);
-    job.firstFrame = range.first;
-    job.lastFrame = range.last;
+  std::optional<FrameRange> range;
+  if (a.frame) range = FrameRange{*a.frame, *a.frame};
+  if (!a.frames.empty()) range = parseFrameRange(a.frames);
+  if (range) {
+    job.firstFrame = range->first;
+    job.lastFrame = range->last;
   }
   ParsedLook look = parseRenderLook(a.look);
   static_cast<RenderRequest&>(job) = look.request;
@@ -39,6 +88,17 @@ void runRender(const RenderArgs& a) {
   job.device = look.device;
   job.saveCamera = a.look.saveCamera;
   job.quiet = a.quiet;
+  std::optional<TemporaryStore> temporary;
+  if (isStoreInput(a.inputs)) {
+    job.store = a.inputs.front();
+  } else {
+    // What runRenderJob checks of the output, before a convert that may take long.
+    checkOutputPattern(job.output, range.value_or(FrameRange{}));
+    const std::uint64_t budget = parseBytes("--mem", a.mem);
+    temporary.emplace();
+    convertForRender(a.inputs, range, budget, a.quiet, *temporary);
+    job.store = temporary->store().string();
+  }
   const auto files = runRenderJob(job);
   const auto unconverged = std::count_if(files.begin(), files.end(), [](const RenderedFile& f) { return !f.stats.converged; });
   if (unconverged > 0)
@@ -53,12 +113,18 @@ void runRender(const RenderArgs& a) {
 
 void addRenderCommand(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
-  auto* cmd = app.add_subcommand("render", "Render brick store frames headless to EXR (R G B A Z N thickness foam) or PNG");
-  cmd->add_option("store", args->store, "Brick store directory")->required();
+  auto* cmd = app.add_subcommand(
+      "render", "Render brick store (or particle file) frames headless to EXR (R G B A Z N thickness foam) or PNG");
+  cmd->add_option("inputs", args->inputs,
+                  "A brick store directory, or particle files / sequence patterns as convert takes them (the "
+                  "frames rendered are converted into a temporary store first)")
+      ->required();
   cmd->add_option("-o,--output", args->output, "Output .exr or .png; '####' takes the frame number")->required();
   auto* frame = cmd->add_option("--frame", args->frame, "Frame to render (default: the first)");
   cmd->add_option("--frames", args->frames, "Frame range A-B (a flipbook; needs '#' in the output name)")
       ->excludes(frame);
+  cmd->add_option("--mem", args->mem, "Converting particle files: the memory budget, e.g. 512M, 8G")
+      ->capture_default_str();
   addRenderLookOptions(*cmd, args->look);
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing");
   cmd->callback([args] { runRender(*args); });

@@ -26,6 +26,13 @@ std::string outputPathForFrame(const std::string& pattern, int frame) {
   return out;
 }
 
+void checkOutputPattern(const std::string& output, FrameRange frames) {
+  if (!isImagePath(output)) throw InputError("-o: '" + output + "' must end in .exr or .png");
+  if (frames.last > frames.first && output.find('#') == std::string::npos)
+    throw InputError("-o: rendering frames " + std::to_string(frames.first) + "-" + std::to_string(frames.last) +
+                     " needs '#' in the output name (e.g. out_####.exr)");
+}
+
 std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
   keepHeapForReuse();  // core/ProcessMemory.h
   BrickStore store = BrickStore::open(job.store);
@@ -39,10 +46,7 @@ std::vector<RenderedFile> runRenderJob(const RenderJob& job) {
     if (!store.hasFrame(f))
       throw InputError(job.store + ": the store has no frame " + std::to_string(f) + " (it has " +
                        std::to_string(stored.front()) + "-" + std::to_string(stored.back()) + ")");
-  if (!isImagePath(job.output)) throw InputError("-o: '" + job.output + "' must end in .exr or .png");
-  if (last > first && job.output.find('#') == std::string::npos)
-    throw InputError("-o: rendering frames " + std::to_string(first) + "-" + std::to_string(last) +
-                     " needs '#' in the output name (e.g. out_####.exr)");
+  checkOutputPattern(job.output, {first, last});
 
   RenderRequest request = job;
   const bool layers = keepsImageLayers(job.output);

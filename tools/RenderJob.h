@@ -8,6 +8,7 @@
 
 #include "pipeline/FramePipeline.h"
 #include "pipeline/RenderRequest.h"
+#include "preprocess/particles/InputSequence.h"
 #include "raycast/Camera.h"
 #include "raycast/FrameRenderer.h"
 #include "raycast/GpuRaycaster.h"
@@ -37,6 +38,10 @@ struct RenderedFile {
 /// store and the frame, checked before anything is written). Prints the device and one line per
 /// frame unless quiet.
 std::vector<RenderedFile> runRenderJob(const RenderJob& job);
+
+/// Throws InputError unless `output` ends in .exr or .png and, for more than one frame, has a
+/// '#' run for the frame number.
+void checkOutputPattern(const std::string& output, FrameRange frames);
 
 /// `pattern` with each run of '#' replaced by `frame`, zero-padded to the run's length.
 std::string outputPathForFrame(const std::string& pattern, int frame);

@@ -2,10 +2,15 @@
 // and clear errors with exit codes 2 (bad options) and 3 (bad files).
 #include <gtest/gtest.h>
 
-#include <filesystem>
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
 #include <cmath>
+#include <csignal>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <string>
 
 #include <glm/geometric.hpp>
@@ -182,6 +187,119 @@ TEST_F(Render, FoamOptionsChangeTheImageAndTheExrHasAFoamLayer) {
   EXPECT_GT(foam, 0.05) << "some foam is visible";
   EXPECT_LT(hitsRemoved, hitsKept) << "removed foam leaves background where only foam was";
   EXPECT_GT(colourChange, 0.05) << "the volume is composited over the image";
+}
+
+/// Sets an environment variable for the commands a test runs, as long as it lives.
+class ScopedEnvironment {
+ public:
+  ScopedEnvironment(const char* name, const std::string& value) : mName(name) {
+    if (const char* old = std::getenv(name)) mOld = old;
+    ::setenv(name, value.c_str(), 1);
+  }
+  ~ScopedEnvironment() {
+    if (mOld)
+      ::setenv(mName, mOld->c_str(), 1);
+    else
+      ::unsetenv(mName);
+  }
+
+ private:
+  const char* mName;
+  std::optional<std::string> mOld;
+};
+
+// Particle files instead of a store: the frames rendered are converted with convert's defaults
+// into a temporary store under $TMPDIR, gone afterwards, and the image is the one convert then
+// render give. Temporary stores a killed render left are removed; a running one's are not.
+TEST_F(Render, ParticleFilesRenderThroughATemporaryStore) {
+  const fs::path tmp = dir / "tmp";
+  const fs::path stale = tmp / "flipscope-render-999999999-Ab12Cd",
+                 live = tmp / ("flipscope-render-" + std::to_string(::getpid()) + "-Ef34Gh");
+  fs::create_directories(stale);
+  fs::create_directories(live);
+  std::ofstream(stale / "store.fsh") << "left by a render killed";
+  // A render of another pid namespace sharing the directory: its pid means nothing here, its lock holds.
+  const fs::path locked = tmp / "flipscope-render-999999998-Ij56Kl";
+  fs::create_directories(locked);
+  const int lock = ::open(locked.c_str(), O_RDONLY | O_DIRECTORY);
+  ASSERT_EQ(::flock(lock, LOCK_EX), 0);
+  const ScopedEnvironment environment("TMPDIR", tmp.string());
+  const std::string size = " --size 64x36 --device cpu --jitter off";
+
+  CommandRun direct = runFlipscope("render " + path("f_####.bin") + " --frame 1 -o " + path("direct.exr") + size);
+  ASSERT_EQ(direct.exitCode, 0) << direct.output;
+  EXPECT_NE(direct.output.find("converting frame 1 of the particle files into a temporary store"), std::string::npos)
+      << direct.output;
+  EXPECT_FALSE(fs::exists(stale)) << "the store of a render whose process is gone is removed";
+  EXPECT_TRUE(fs::exists(live)) << "the store of a running render stays";
+  EXPECT_TRUE(fs::exists(locked)) << "the store of a running render of another pid namespace stays";
+  ::close(lock);
+  fs::remove_all(live);
+  fs::remove_all(locked);
+  EXPECT_TRUE(fs::is_empty(tmp)) << "the temporary store is removed after the render";
+
+  CommandRun convert = runFlipscope("convert " + path("f_####.bin") + " --frames 1 -o " + path("defaults") + " -q");
+  ASSERT_EQ(convert.exitCode, 0) << convert.output;
+  CommandRun stored = runFlipscope("render " + path("defaults") + " --frame 1 -o " + path("stored.exr") + size);
+  ASSERT_EQ(stored.exitCode, 0) << stored.output;
+  const flipscope::RenderImage a = flipscope::readExr(path("direct.exr")).image;
+  const flipscope::RenderImage b = flipscope::readExr(path("stored.exr")).image;
+  ASSERT_EQ(a.depth.size(), b.depth.size());
+  std::size_t covered = 0, differ = 0;
+  for (std::size_t i = 0; i < a.depth.size(); ++i) {
+    covered += std::isfinite(a.depth[i]);
+    differ +=
+        !(a.depth[i] == b.depth[i] || (std::isinf(a.depth[i]) && std::isinf(b.depth[i]))) || a.rgba[i] != b.rgba[i];
+  }
+  EXPECT_GT(covered, 64u * 36u / 10);
+  EXPECT_EQ(differ, 0u) << "the same image as convert, then render";
+
+  // No --frame: the first frame only; --frames: a flipbook of the frames converted together.
+  CommandRun first = runFlipscope("render " + path("f_####.bin") + " -o " + path("first.png") + size);
+  ASSERT_EQ(first.exitCode, 0) << first.output;
+  EXPECT_NE(first.output.find("converting frame 0 "), std::string::npos) << first.output;
+  EXPECT_EQ(pngSize(path("first.png")), std::make_pair(64u, 36u));
+  CommandRun book = runFlipscope("render " + path("f_####.bin") + " --frames 0-1 -o " + path("book_####.png") + size);
+  ASSERT_EQ(book.exitCode, 0) << book.output;
+  EXPECT_NE(book.output.find("converting frames 0-1 "), std::string::npos) << book.output;
+  EXPECT_TRUE(fs::exists(path("book_0000.png")) && fs::exists(path("book_0001.png")));
+  EXPECT_TRUE(fs::is_empty(tmp));
+
+  // Bad inputs: the file or the option named, exit 3 or 2, no image and no store left.
+  {
+    std::ofstream bad(path("bad.ply"));
+    bad << "ply\nformat binary_little_endian 1.0\nelement vertex 1000\nproperty float x\nproperty float y\n"
+           "property float z\nend_header\n0123456789";
+  }
+  CommandRun damaged = runFlipscope("render " + path("bad.ply") + " -o " + path("bad.png") + size);
+  EXPECT_EQ(damaged.exitCode, 3) << damaged.output;
+  EXPECT_NE(damaged.output.find("bad.ply"), std::string::npos) << damaged.output;
+  CommandRun plain = runFlipscope("render " + path("f_0000.bin") + " --frames 0-1 -o " + path("p_####.png") + size);
+  EXPECT_EQ(plain.exitCode, 2) << plain.output;
+  EXPECT_NE(plain.output.find("no frame pattern"), std::string::npos) << plain.output;
+  CommandRun output = runFlipscope("render " + path("f_####.bin") + " --frames 0-1 -o " + path("p.png") + size);
+  EXPECT_EQ(output.exitCode, 2) << output.output;
+  EXPECT_EQ(output.output.find("converting"), std::string::npos) << "the output is checked before converting";
+  EXPECT_FALSE(fs::exists(path("bad.png")) || fs::exists(path("p_0000.png")) || fs::exists(path("p.png")));
+  EXPECT_TRUE(fs::is_empty(tmp));
+
+  // SIGTERM while converting (the convert's test hook, Convert.h) removes the store; between
+  // two frames, the frame already listed stays, and the next render removes it.
+  {
+    const ScopedEnvironment stop("FLIPSCOPE_CONVERT_STOP", "brick:1:TERM");
+    CommandRun stopped = runFlipscope("render " + path("f_####.bin") + " -o " + path("s.png") + size);
+    EXPECT_EQ(stopped.exitCode, 128 + SIGTERM) << stopped.output;
+  }
+  EXPECT_TRUE(fs::is_empty(tmp));
+  {
+    const ScopedEnvironment stop("FLIPSCOPE_CONVERT_STOP", "frame:1:TERM");
+    CommandRun stopped = runFlipscope("render " + path("f_####.bin") + " --frames 0-1 -o " + path("s_####.png") + size);
+    EXPECT_EQ(stopped.exitCode, 128 + SIGTERM) << stopped.output;
+  }
+  EXPECT_FALSE(fs::is_empty(tmp));
+  ASSERT_EQ(runFlipscope("render " + path("f_####.bin") + " -o " + path("s.png") + size).exitCode, 0);
+  EXPECT_TRUE(fs::is_empty(tmp));
+  EXPECT_FALSE(fs::exists(path("s_0000.png")));
 }
 
 TEST_F(Render, BadInputsGiveClearErrors) {
