@@ -44,7 +44,8 @@ void sleepBriefly() {
 }
 
 /// Async-signal-safe: unlinks every registered file, then rmdirs every registered directory,
-/// twice: a directory registered before one inside it is empty only on the second pass.
+/// twice: a directory in an earlier slot than a registered one inside it is empty only on the
+/// second pass.
 void removeRegistered() {
   for (char kind : {'f', 'd', 'd'}) {
     for (Slot& slot : gSlots) {

@@ -29,9 +29,9 @@ namespace flipscope {
 /// Registers a path to remove when the process is stopped by SIGINT, SIGTERM or SIGHUP, for as
 /// long as the object lives (or until release()). Destroying it does not remove the path.
 /// installCleanupSignalHandlers() makes those signals unlink every registered file, then rmdir
-/// every registered directory (only an empty one goes; twice, so that one emptied by the
-/// removal of a directory inside it goes too, in whatever order they were registered), then end the process by the same
-/// signal with its default action. The handler is async-signal-safe: it uses atomics and calls
+/// every registered directory (only an empty one goes; twice, so that a directory emptied by
+/// the removal of a registered one inside it goes too, one level deep), then end the process by
+/// the same signal with its default action. The handler is async-signal-safe: it uses atomics and calls
 /// unlink, rmdir, nanosleep and raise only. Registration is thread safe; at most kCleanupSlots paths are
 /// registered at once, beyond that a registration does nothing (registered() is false).
 class CleanupOnSignal {

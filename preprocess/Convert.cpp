@@ -971,6 +971,8 @@ FrameReport convertFrame(ParticleSource& source, BrickStore& store, int frame, c
   return convertOneFrame(source, store, frame, options, progress, nullptr);
 }
 
+void testStopPoint(const char* point) { stopPoint(point); }
+
 ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesystem::path& storeDir,
                       const ConvertOptions& options) {
   if (inputs.empty()) throw InputError("convert: no input frames");

@@ -49,7 +49,9 @@
 // the step that registers it for removal), directory (created and locked), header (store.fsh
 // written), chunk (a chunk of particles read), spill (a spill file written to), brick (a brick
 // appended to the frame's temporary, on the thread that appends it), frame-file (the frame file
-// committed, not listed yet), frame (listed in store.fsh).
+// committed, not listed yet), frame (listed in store.fsh); and, through testStopPoint, the
+// commands' own points around a convert: render-store (`render` of particle files: the store it
+// converted registered for removal, before it renders).
 #pragma once
 
 #include <cstdint>
@@ -141,6 +143,9 @@ struct ConvertReport {
   /// Worth telling the user (e.g. a fallback from one cell per particle spacing).
   std::vector<std::string> warnings;
 };
+
+/// The test hook above at `point`, for a command's own points around a convert.
+void testStopPoint(const char* point);
 
 /// Converts every frame of `inputs` into the store at `storeDir` (created, or appended to:
 /// then its domain and cell size are kept). Throws InputError/FileError.

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 namespace flipscope::testing {
@@ -72,5 +73,26 @@ inline CommandRun runFlipscope(const std::string& arguments, const std::filesyst
   const int status = pclose(pipe);
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
 }
+
+/// Sets an environment variable, for the commands a test runs, while it lives.
+class ScopedEnvironment {
+ public:
+  ScopedEnvironment(const char* name, const std::string& value) : mName(name) {
+    if (const char* old = std::getenv(name)) mOld = old;
+    ::setenv(name, value.c_str(), 1);
+  }
+  ~ScopedEnvironment() {
+    if (mOld)
+      ::setenv(mName, mOld->c_str(), 1);
+    else
+      ::unsetenv(mName);
+  }
+  ScopedEnvironment(const ScopedEnvironment&) = delete;
+  ScopedEnvironment& operator=(const ScopedEnvironment&) = delete;
+
+ private:
+  const char* mName;
+  std::optional<std::string> mOld;
+};
 
 }  // namespace flipscope::testing

@@ -33,21 +33,18 @@ struct RenderArgs {
   bool quiet = false;
 };
 
-/// A brick store directory: one input that is a directory.
-bool isStoreInput(const std::vector<std::string>& inputs) {
-  return inputs.size() == 1 && std::filesystem::is_directory(inputs.front());
-}
-
-/// Converts the frames of `inputs` that the render asks for (`range`; unset: the first frame
-/// found) into `store`, with convert's defaults and `memoryBudget`.
-void convertForRender(const std::vector<std::string>& inputs, std::optional<FrameRange> range,
-                      std::uint64_t memoryBudget, bool quiet, TemporaryStore& store) {
-  installCleanupSignalHandlers();  // the convert's temporaries, then the store, go on a signal
-  std::vector<FrameInput> frames = expandInputs(inputs, range);
-  if (!range && frames.size() > 1) frames.resize(1);
-  if (range && range->last > range->first && frames.size() == 1)
+/// The frames of particle `inputs` a render converts: `range`, else the first frame found.
+std::vector<FrameInput> framesToConvert(const std::vector<std::string>& inputs, std::optional<FrameRange> range) {
+  if (range && range->last > range->first && std::none_of(inputs.begin(), inputs.end(), hasFramePattern))
     throw InputError("--frames " + std::to_string(range->first) + "-" + std::to_string(range->last) + ": the inputs " +
                      "have no frame pattern (name_####.ext), so they are one frame; give --frame");
+  const int first = range ? range->first : firstFrameOf(inputs);
+  return expandInputs(inputs, range.value_or(FrameRange{first, first}));
+}
+
+/// Converts `frames` into `store` with convert's defaults and `memoryBudget`.
+void convertForRender(const std::vector<FrameInput>& frames, std::uint64_t memoryBudget, bool quiet,
+                      TemporaryStore& store) {
   ConvertOptions options;
   options.memoryBudget = memoryBudget;
   options.progress = quiet ? Progress::Mode::Silent : Progress::Mode::Auto;
@@ -61,7 +58,8 @@ void convertForRender(const std::vector<std::string>& inputs, std::optional<Fram
         which.c_str());
   std::fflush(stdout);
   const ConvertReport report = convert(frames, store.store(), options);
-  store.hold();
+  store.registerForSignalCleanup();
+  testStopPoint("render-store");
   for (const auto& warning : report.warnings) std::fprintf(stderr, "warning: %s\n", warning.c_str());
   if (quiet) return;
   std::uint64_t particles = 0;
@@ -89,14 +87,16 @@ void runRender(const RenderArgs& a) {
   job.saveCamera = a.look.saveCamera;
   job.quiet = a.quiet;
   std::optional<TemporaryStore> temporary;
-  if (isStoreInput(a.inputs)) {
+  if (isStoreDirectory(a.inputs)) {
     job.store = a.inputs.front();
   } else {
-    // What runRenderJob checks of the output, before a convert that may take long.
+    // What runRenderJob checks of the output and the inputs, before a convert that may take long.
     checkOutputPattern(job.output, range.value_or(FrameRange{}));
     const std::uint64_t budget = parseBytes("--mem", a.mem);
+    const std::vector<FrameInput> frames = framesToConvert(a.inputs, range);
+    installCleanupSignalHandlers();  // the convert's temporaries, then the store, go on a signal
     temporary.emplace();
-    convertForRender(a.inputs, range, budget, a.quiet, *temporary);
+    convertForRender(frames, budget, a.quiet, *temporary);
     job.store = temporary->store().string();
   }
   const auto files = runRenderJob(job);
@@ -123,7 +123,8 @@ void addRenderCommand(CLI::App& app) {
   auto* frame = cmd->add_option("--frame", args->frame, "Frame to render (default: the first)");
   cmd->add_option("--frames", args->frames, "Frame range A-B (a flipbook; needs '#' in the output name)")
       ->excludes(frame);
-  cmd->add_option("--mem", args->mem, "Converting particle files: the memory budget, e.g. 512M, 8G")
+  cmd->add_option("--mem", args->mem,
+                  "Converting particle files (not used with a store): the memory budget, e.g. 512M, 8G")
       ->capture_default_str();
   addRenderLookOptions(*cmd, args->look);
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing");

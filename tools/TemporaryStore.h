@@ -1,17 +1,15 @@
-// TemporaryStore: the place of a brick store in a fresh directory under the system's temporary
-// directory ($TMPDIR, else /tmp), removed with what it holds when the object is destroyed.
-// `render` given particle files converts the frames it renders into one
-// (tools/RenderCommand.cpp).
+// TemporaryStore: a directory under the system's temporary directory ($TMPDIR, else /tmp) for a
+// brick store one command makes and reads, removed with what it holds when the object is
+// destroyed. `render` given particle files converts the frames it renders into one.
 //
-// Contract. The directory is `flipscope-render-<pid>-<random>`, and the store `store` inside
-// it, which the convert creates (so that a signal during the convert removes what it made, as
-// it would of any store it creates). SIGINT, SIGTERM and SIGHUP remove the directory once it is
-// empty, and, once hold() has registered the store's files, all of it (CleanupOnSignal, after
-// installCleanupSignalHandlers()). What a killed process leaves (SIGKILL, power loss, a signal
-// between two frames of a convert) is removed by the next TemporaryStore made on the machine,
-// once no process of that pid lives (processExists), as AtomicFile's stale temporaries are, and
-// none holds the directory's lock (flock, which a process holds while its TemporaryStore lives:
-// a render in another pid namespace that shares the directory keeps its store).
+// Contract:
+//  - the directory is `flipscope-render-<pid>-<random>` (mode 0700), locked (flock) while the
+//    object lives; the store is store() inside it, which the convert makes;
+//  - SIGINT, SIGTERM and SIGHUP remove the directory when it is empty (a convert stopped by one
+//    removes the store it made), and all of it once registerForSignalCleanup() has registered
+//    the store's files (installCleanupSignalHandlers() must have run);
+//  - the constructor first removes this user's temporary stores that no process locks: those a
+//    SIGKILL or a power loss left, or a signal between two frames of the convert.
 #pragma once
 
 #include <filesystem>
@@ -23,25 +21,22 @@ namespace flipscope::tools {
 
 class TemporaryStore {
  public:
-  /// Creates the directory (an OutputError naming the temporary directory when it cannot), after
-  /// removing the stale ones.
+  /// Throws OutputError naming the temporary directory when the store's cannot be made there.
   TemporaryStore();
   ~TemporaryStore();
   TemporaryStore(const TemporaryStore&) = delete;
   TemporaryStore& operator=(const TemporaryStore&) = delete;
 
-  /// The store's directory (not made yet: the convert makes it).
+  /// The store's directory (the convert makes it).
   std::filesystem::path store() const { return mPath / "store"; }
-  /// Registers the store's files and directory for removal by the cleanup signals.
-  void hold();
-
-  /// The pid in the name of a temporary store's directory; 0 when `name` is not one.
-  static long ownerOf(const std::string& name);
+  /// Registers the store's files and directory for removal by the cleanup signals (at most
+  /// CleanupOnSignal::kCleanupSlots in all; beyond, the rest is left to the next TemporaryStore).
+  void registerForSignalCleanup();
 
  private:
   std::filesystem::path mPath;
-  int mLock = -1;  ///< the directory, opened and locked
-  std::vector<CleanupOnSignal> mCleanup;  ///< the directory, then the store's files and directory
+  int mLock = -1;                         ///< mPath, opened and locked
+  std::vector<CleanupOnSignal> mCleanup;  ///< mPath, then the store's files and directory
 };
 
 }  // namespace flipscope::tools

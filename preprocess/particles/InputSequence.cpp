@@ -179,6 +179,16 @@ std::string substituteFrame(const std::string& pattern, int frame) {
 
 bool hasFramePattern(const std::string& input) { return findPattern(input).has_value(); }
 
+int firstFrameOf(const std::vector<std::string>& inputs) {
+  const auto firstPattern = std::find_if(inputs.begin(), inputs.end(), hasFramePattern);
+  if (firstPattern == inputs.end()) return 0;
+  return discoverFrames(*firstPattern, *findPattern(*firstPattern)).front();
+}
+
+bool isStoreDirectory(const std::vector<std::string>& inputs) {
+  return inputs.size() == 1 && std::filesystem::is_directory(inputs.front());
+}
+
 std::vector<FrameInput> expandInputs(const std::vector<std::string>& inputs, std::optional<FrameRange> frames) {
   if (inputs.empty()) throw InputError("no input files");
   auto firstPattern = std::find_if(inputs.begin(), inputs.end(), hasFramePattern);

@@ -32,6 +32,14 @@ FrameRange parseFrameRange(const std::string& text);
 /// (names the missing path and the frame).
 std::vector<FrameInput> expandInputs(const std::vector<std::string>& inputs, std::optional<FrameRange> frames);
 
+/// The first frame expandInputs(inputs, nullopt) would give, without checking the files of the
+/// others: the smallest frame number of the first pattern's files, or 0 when no input has a
+/// pattern. Throws as expandInputs when that pattern matches nothing.
+int firstFrameOf(const std::vector<std::string>& inputs);
+
+/// Whether `inputs` name a brick store rather than particle files: one input, a directory.
+bool isStoreDirectory(const std::vector<std::string>& inputs);
+
 /// Substitutes `frame` into a pattern; returns the input unchanged if it has no pattern.
 std::string substituteFrame(const std::string& pattern, int frame);
 bool hasFramePattern(const std::string& input);

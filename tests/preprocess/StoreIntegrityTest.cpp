@@ -405,11 +405,16 @@ TEST(CleanupOnSignal, SigintSigtermAndSighupRemoveTheRegisteredPathsThenEndThePr
     testing::TempDir temp("signal");
     const fs::path dir = temp / "made";
     const int status = inChildRaising(signal, [&] {
-      static CleanupOnSignal registered[4];
+      static CleanupOnSignal registered[6];
       fs::create_directories(dir);
       registered[0] = CleanupOnSignal(dir, CleanupOnSignal::Kind::Directory);
       touch(dir / "a");
       registered[1] = CleanupOnSignal(dir / "a");
+      // A directory inside one registered before it: both go.
+      fs::create_directories(dir / "inner");
+      registered[4] = CleanupOnSignal(dir / "inner", CleanupOnSignal::Kind::Directory);
+      touch(dir / "inner" / "e");
+      registered[5] = CleanupOnSignal(dir / "inner" / "e");
       touch(temp / "b");
       registered[2] = CleanupOnSignal(temp / "b");
       touch(temp / "c");

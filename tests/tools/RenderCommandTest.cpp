@@ -189,53 +189,44 @@ TEST_F(Render, FoamOptionsChangeTheImageAndTheExrHasAFoamLayer) {
   EXPECT_GT(colourChange, 0.05) << "the volume is composited over the image";
 }
 
-/// Sets an environment variable for the commands a test runs, as long as it lives.
-class ScopedEnvironment {
- public:
-  ScopedEnvironment(const char* name, const std::string& value) : mName(name) {
-    if (const char* old = std::getenv(name)) mOld = old;
-    ::setenv(name, value.c_str(), 1);
-  }
-  ~ScopedEnvironment() {
-    if (mOld)
-      ::setenv(mName, mOld->c_str(), 1);
-    else
-      ::unsetenv(mName);
-  }
-
- private:
-  const char* mName;
-  std::optional<std::string> mOld;
-};
-
 // Particle files instead of a store: the frames rendered are converted with convert's defaults
 // into a temporary store under $TMPDIR, gone afterwards, and the image is the one convert then
-// render give. Temporary stores a killed render left are removed; a running one's are not.
+// render give. Temporary stores a killed render left are removed; a running one's (locked) are
+// not, nor other users' entries, nor what a symlink points to.
 TEST_F(Render, ParticleFilesRenderThroughATemporaryStore) {
   const fs::path tmp = dir / "tmp";
-  const fs::path stale = tmp / "flipscope-render-999999999-Ab12Cd",
-                 live = tmp / ("flipscope-render-" + std::to_string(::getpid()) + "-Ef34Gh");
+  const fs::path stale = tmp / "flipscope-render-999999999-Ab12Cd", running = tmp / "flipscope-render-1-Ef34Gh";
   fs::create_directories(stale);
-  fs::create_directories(live);
   std::ofstream(stale / "store.fsh") << "left by a render killed";
-  // A render of another pid namespace sharing the directory: its pid means nothing here, its lock holds.
-  const fs::path locked = tmp / "flipscope-render-999999998-Ij56Kl";
-  fs::create_directories(locked);
-  const int lock = ::open(locked.c_str(), O_RDONLY | O_DIRECTORY);
+  fs::create_directories(running);
+  const int lock = ::open(running.c_str(), O_RDONLY | O_DIRECTORY);
   ASSERT_EQ(::flock(lock, LOCK_EX), 0);
-  const ScopedEnvironment environment("TMPDIR", tmp.string());
+  fs::create_directories(dir / "kept");
+  std::ofstream(dir / "kept" / "file") << "not a temporary store";
+  fs::create_symlink(dir / "kept", tmp / "flipscope-render-2-Ij56Kl");
+  const bool root = ::geteuid() == 0;  // another user's entry can be made only as root
+  const fs::path foreign = tmp / "flipscope-render-3-Mn78Op";
+  if (root) {
+    fs::create_directories(foreign);
+    ASSERT_EQ(::chown(foreign.c_str(), 65534, 65534), 0);
+  }
+  const flipscope::testing::ScopedEnvironment environment("TMPDIR", tmp.string());
   const std::string size = " --size 64x36 --device cpu --jitter off";
 
   CommandRun direct = runFlipscope("render " + path("f_####.bin") + " --frame 1 -o " + path("direct.exr") + size);
   ASSERT_EQ(direct.exitCode, 0) << direct.output;
   EXPECT_NE(direct.output.find("converting frame 1 of the particle files into a temporary store"), std::string::npos)
       << direct.output;
-  EXPECT_FALSE(fs::exists(stale)) << "the store of a render whose process is gone is removed";
-  EXPECT_TRUE(fs::exists(live)) << "the store of a running render stays";
-  EXPECT_TRUE(fs::exists(locked)) << "the store of a running render of another pid namespace stays";
+  EXPECT_FALSE(fs::exists(stale)) << "the store of a render that is gone is removed";
+  EXPECT_TRUE(fs::exists(running)) << "the store of a running render stays";
+  EXPECT_TRUE(fs::exists(dir / "kept" / "file")) << "a symlink is not followed";
+  if (root) {
+    EXPECT_TRUE(fs::exists(foreign)) << "another user's entry stays";
+    fs::remove(foreign);
+  }
   ::close(lock);
-  fs::remove_all(live);
-  fs::remove_all(locked);
+  fs::remove_all(running);
+  fs::remove(tmp / "flipscope-render-2-Ij56Kl");
   EXPECT_TRUE(fs::is_empty(tmp)) << "the temporary store is removed after the render";
 
   CommandRun convert = runFlipscope("convert " + path("f_####.bin") + " --frames 1 -o " + path("defaults") + " -q");
@@ -254,8 +245,12 @@ TEST_F(Render, ParticleFilesRenderThroughATemporaryStore) {
   EXPECT_GT(covered, 64u * 36u / 10);
   EXPECT_EQ(differ, 0u) << "the same image as convert, then render";
 
-  // No --frame: the first frame only; --frames: a flipbook of the frames converted together.
-  CommandRun first = runFlipscope("render " + path("f_####.bin") + " -o " + path("first.png") + size);
+  // No --frame: the first frame found, whatever later frames lack (here f_0001's companion);
+  // --frames: a flipbook of the frames converted together; a file without a pattern is the
+  // frame --frame names.
+  fs::copy_file(path("f_0000.bin"), path("g_0000.bin"));
+  CommandRun first =
+      runFlipscope("render " + path("f_####.bin") + " " + path("g_####.bin") + " -o " + path("first.png") + size);
   ASSERT_EQ(first.exitCode, 0) << first.output;
   EXPECT_NE(first.output.find("converting frame 0 "), std::string::npos) << first.output;
   EXPECT_EQ(pngSize(path("first.png")), std::make_pair(64u, 36u));
@@ -263,9 +258,14 @@ TEST_F(Render, ParticleFilesRenderThroughATemporaryStore) {
   ASSERT_EQ(book.exitCode, 0) << book.output;
   EXPECT_NE(book.output.find("converting frames 0-1 "), std::string::npos) << book.output;
   EXPECT_TRUE(fs::exists(path("book_0000.png")) && fs::exists(path("book_0001.png")));
+  CommandRun plainFrame = runFlipscope("render " + path("f_0001.bin") + " --frame 5 -o " + path("five_#.png") + size);
+  ASSERT_EQ(plainFrame.exitCode, 0) << plainFrame.output;
+  EXPECT_NE(plainFrame.output.find("frame 5:"), std::string::npos) << plainFrame.output;
+  EXPECT_TRUE(fs::exists(path("five_5.png")));
   EXPECT_TRUE(fs::is_empty(tmp));
 
-  // Bad inputs: the file or the option named, exit 3 or 2, no image and no store left.
+  // Bad inputs: the file or the option named, exit 3 or 2, no image and no store left; the
+  // output and the inputs are checked before anything is made.
   {
     std::ofstream bad(path("bad.ply"));
     bad << "ply\nformat binary_little_endian 1.0\nelement vertex 1000\nproperty float x\nproperty float y\n"
@@ -277,22 +277,29 @@ TEST_F(Render, ParticleFilesRenderThroughATemporaryStore) {
   CommandRun plain = runFlipscope("render " + path("f_0000.bin") + " --frames 0-1 -o " + path("p_####.png") + size);
   EXPECT_EQ(plain.exitCode, 2) << plain.output;
   EXPECT_NE(plain.output.find("no frame pattern"), std::string::npos) << plain.output;
+  CommandRun missing =
+      runFlipscope("render " + path("f_####.bin") + " " + path("g_####.bin") + " --frame 1 -o " + path("m.png") + size);
+  EXPECT_EQ(missing.exitCode, 3) << missing.output;
+  EXPECT_NE(missing.output.find("g_0001.bin"), std::string::npos) << missing.output;
   CommandRun output = runFlipscope("render " + path("f_####.bin") + " --frames 0-1 -o " + path("p.png") + size);
   EXPECT_EQ(output.exitCode, 2) << output.output;
-  EXPECT_EQ(output.output.find("converting"), std::string::npos) << "the output is checked before converting";
-  EXPECT_FALSE(fs::exists(path("bad.png")) || fs::exists(path("p_0000.png")) || fs::exists(path("p.png")));
+  for (const CommandRun* run : {&plain, &missing, &output})
+    EXPECT_EQ(run->output.find("converting"), std::string::npos) << run->output;
+  EXPECT_FALSE(fs::exists(path("bad.png")) || fs::exists(path("p_0000.png")) || fs::exists(path("p.png")) ||
+               fs::exists(path("m.png")));
   EXPECT_TRUE(fs::is_empty(tmp));
 
-  // SIGTERM while converting (the convert's test hook, Convert.h) removes the store; between
-  // two frames, the frame already listed stays, and the next render removes it.
-  {
-    const ScopedEnvironment stop("FLIPSCOPE_CONVERT_STOP", "brick:1:TERM");
+  // SIGTERM while converting (the convert's test hook, Convert.h) removes the store, and so does
+  // one after it, before the render; between two frames, the frame already listed stays, and
+  // the next render removes it.
+  for (const char* stop : {"brick:1:TERM", "render-store:1:TERM"}) {
+    const flipscope::testing::ScopedEnvironment stopAt("FLIPSCOPE_CONVERT_STOP", stop);
     CommandRun stopped = runFlipscope("render " + path("f_####.bin") + " -o " + path("s.png") + size);
-    EXPECT_EQ(stopped.exitCode, 128 + SIGTERM) << stopped.output;
+    EXPECT_EQ(stopped.exitCode, 128 + SIGTERM) << stop << "\n" << stopped.output;
+    EXPECT_TRUE(fs::is_empty(tmp)) << stop;
   }
-  EXPECT_TRUE(fs::is_empty(tmp));
   {
-    const ScopedEnvironment stop("FLIPSCOPE_CONVERT_STOP", "frame:1:TERM");
+    const flipscope::testing::ScopedEnvironment stopAt("FLIPSCOPE_CONVERT_STOP", "frame:1:TERM");
     CommandRun stopped = runFlipscope("render " + path("f_####.bin") + " --frames 0-1 -o " + path("s_####.png") + size);
     EXPECT_EQ(stopped.exitCode, 128 + SIGTERM) << stopped.output;
   }

@@ -18,6 +18,7 @@
 #include "core/Error.h"
 #include "gl/EglContext.h"
 #include "pipeline/ImageWriter.h"
+#include "preprocess/particles/InputSequence.h"
 #include "raycast/CpuRaycaster.h"
 #include "raycast/GpuRaycaster.h"
 #include "raycast/TiledCpuRaycaster.h"
@@ -51,10 +52,8 @@ std::string keyName(int key) {
 }
 
 /// W A S D Q E: the keys that move the camera in fly mode.
-bool isFlyKey(const std::string& name) { return name.size() == 1 && std::string_view("wasdqe").find(name[0]) != std::string_view::npos; }
-
-bool isStore(const std::vector<std::string>& inputs) {
-  return inputs.size() == 1 && std::filesystem::is_directory(inputs.front());
+bool isFlyKey(const std::string& name) {
+  return name.size() == 1 && std::string_view("wasdqe").find(name[0]) != std::string_view::npos;
 }
 }  // namespace
 
@@ -117,7 +116,7 @@ ViewerApp::~ViewerApp() {
 }
 
 void ViewerApp::openSource() {
-  if (isStore(mOptions.inputs)) {
+  if (isStoreDirectory(mOptions.inputs)) {
     mStoreDir = mOptions.inputs.front();
     BrickStore store = BrickStore::open(mStoreDir);
     if (store.incomplete())
