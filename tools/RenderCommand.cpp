@@ -57,7 +57,14 @@ void convertForRender(const std::vector<FrameInput>& frames, std::uint64_t memor
         "to keep)\n",
         which.c_str());
   std::fflush(stdout);
-  const ConvertReport report = convert(frames, store.store(), options);
+  ConvertReport report;
+  try {
+    report = convert(frames, store.store(), options);
+  } catch (const OutputError& e) {  // a full or small $TMPDIR: say where the store went
+    const std::string message = e.what(), prefix = e.path().string() + ": ";
+    throw OutputError(e.path(), (message.starts_with(prefix) ? message.substr(prefix.size()) : message) + " " +
+                                    std::string(kTemporaryStoreHint));
+  }
   store.registerForSignalCleanup();
   testStopPoint("render-store");
   for (const auto& warning : report.warnings) std::fprintf(stderr, "warning: %s\n", warning.c_str());

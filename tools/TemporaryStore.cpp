@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -59,14 +60,19 @@ void removeStaleTemporaryStores(const fs::path& temporaryDir) {
 TemporaryStore::TemporaryStore() {
   std::error_code ec;
   const fs::path temporaryDir = fs::temp_directory_path(ec);
-  if (ec) throw OutputError("$TMPDIR", "no temporary directory for the store of the particle files: " + ec.message());
+  if (ec) {
+    const char* named = std::getenv("TMPDIR");
+    throw OutputError(named ? named : "$TMPDIR", "no temporary directory for the store of the particle files: " +
+                                                     ec.message() + " " + std::string(kTemporaryStoreHint));
+  }
   removeStaleTemporaryStores(temporaryDir);
   const std::string pid = std::to_string(::getpid());
   std::string making = (temporaryDir / (std::string(kUnlockedPrefix) + pid + "-XXXXXX")).string();
   {
     const DeferCleanupSignals step;  // created and registered as one step
     if (!::mkdtemp(making.data()))
-      throw OutputError(temporaryDir, "cannot create a temporary store for the particle files: " + errnoText());
+      throw OutputError(temporaryDir, "cannot create a temporary store for the particle files: " + errnoText() + " " +
+                                          std::string(kTemporaryStoreHint));
     mCleanup.emplace_back(making, CleanupOnSignal::Kind::Directory);
   }
   mLock = lockDirectory(making, true);

@@ -13,11 +13,17 @@
 #pragma once
 
 #include <filesystem>
+#include <string_view>
 #include <vector>
 
 #include "core/AtomicFile.h"
 
 namespace flipscope::tools {
+
+/// What the errors of a temporary store suggest.
+inline constexpr std::string_view kTemporaryStoreHint =
+    "(the store of particle files goes under $TMPDIR: set TMPDIR to a directory with room, or convert into a store "
+    "and render that)";
 
 class TemporaryStore {
  public:

@@ -285,8 +285,14 @@ TEST_F(Render, ParticleFilesRenderThroughATemporaryStore) {
   EXPECT_EQ(output.exitCode, 2) << output.output;
   for (const CommandRun* run : {&plain, &missing, &output})
     EXPECT_EQ(run->output.find("converting"), std::string::npos) << run->output;
+  {
+    const flipscope::testing::ScopedEnvironment nowhere("TMPDIR", path("bad.ply"));  // a file, not a directory
+    CommandRun noTemporary = runFlipscope("render " + path("f_####.bin") + " -o " + path("t.png") + size);
+    EXPECT_EQ(noTemporary.exitCode, 4) << noTemporary.output;
+    EXPECT_NE(noTemporary.output.find("set TMPDIR"), std::string::npos) << noTemporary.output;
+  }
   EXPECT_FALSE(fs::exists(path("bad.png")) || fs::exists(path("p_0000.png")) || fs::exists(path("p.png")) ||
-               fs::exists(path("m.png")));
+               fs::exists(path("m.png")) || fs::exists(path("t.png")));
   EXPECT_TRUE(fs::is_empty(tmp));
 
   // SIGTERM while converting (the convert's test hook, Convert.h) removes the store, and so does
