@@ -73,8 +73,8 @@ void convertForRender(const std::vector<FrameInput>& frames, std::uint64_t memor
   double seconds = 0;
   for (const FrameReport& f : report.frames) particles += f.stats.particles, seconds += f.seconds;
   std::printf("render: converted %s particles in %.2f s; cell size %g (%s)\n",
-              Progress::humanCount(double(particles)).c_str(), seconds, report.header.cellSize,
-              report.cellSizeOrigin.c_str());
+              particles < 1000 ? std::to_string(particles).c_str() : Progress::humanCount(double(particles)).c_str(),
+              seconds, report.header.cellSize, report.cellSizeOrigin.c_str());
 }
 
 void runRender(const RenderArgs& a) {
