@@ -17,7 +17,6 @@
 
 namespace flipscope {
 namespace {
-std::string errnoText() { return std::strerror(errno); }
 std::atomic<unsigned> gTemporaryCounter{0};
 
 // ---- the registry of CleanupOnSignal ------------------------------------------------------

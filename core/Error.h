@@ -6,6 +6,8 @@
 //    code that meets them and reported, never thrown.
 #pragma once
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <sstream>
 #include <stdexcept>
@@ -45,6 +47,10 @@ inline std::string printableText(const std::string& text) {
   }
   return out;
 }
+
+/// The text of the current errno (strerror), for the messages of failed system calls. Call it
+/// at once after the call: anything between may change errno.
+inline std::string errnoText() { return std::strerror(errno); }
 
 /// A file that cannot be read or written, or whose content is malformed.
 /// what() reads "<path>: <reason>", the reason made printable (printableText).

@@ -24,8 +24,6 @@ constexpr std::string_view kTemporaryStorePrefix = "flipscope-render-";
 /// the sweep never meets one of its names unlocked while its process lives.
 constexpr std::string_view kUnlockedPrefix = ".flipscope-render-making-";
 
-std::string errnoText() { return std::system_category().message(errno); }
-
 /// `dir` opened (not through a symlink) and locked, exclusively; -1 when it cannot be opened or,
 /// without `wait`, another open file description holds its lock. Locks end with the process.
 int lockDirectory(const fs::path& dir, bool wait) {

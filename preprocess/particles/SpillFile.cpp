@@ -17,8 +17,6 @@
 namespace flipscope::detail {
 namespace {
 
-std::string errnoText() { return std::strerror(errno); }
-
 /// An open descriptor of a new unnamed file in `dir`, or -1 (errno set).
 int openUnnamed(const std::filesystem::path& dir) {
 #ifdef O_TMPFILE
