@@ -57,11 +57,14 @@ inline std::string errnoText() { return std::strerror(errno); }
 class FileError : public InputError {
  public:
   FileError(const std::filesystem::path& path, const std::string& reason)
-      : InputError(path.string() + ": " + printableText(reason)), mPath(path) {}
+      : InputError(path.string() + ": " + printableText(reason)), mPath(path), mReason(printableText(reason)) {}
   const std::filesystem::path& path() const { return mPath; }
+  /// what() without the path.
+  const std::string& reason() const { return mReason; }
 
  private:
   std::filesystem::path mPath;
+  std::string mReason;
 };
 
 /// An output that cannot be created or written (a missing or read-only directory, a full

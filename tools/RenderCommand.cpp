@@ -61,9 +61,7 @@ void convertForRender(const std::vector<FrameInput>& frames, std::uint64_t memor
   try {
     report = convert(frames, store.store(), options);
   } catch (const OutputError& e) {  // a full or small $TMPDIR: say where the store went
-    const std::string message = e.what(), prefix = e.path().string() + ": ";
-    throw OutputError(e.path(), (message.starts_with(prefix) ? message.substr(prefix.size()) : message) + " " +
-                                    std::string(kTemporaryStoreHint));
+    throw OutputError(e.path(), e.reason() + " " + std::string(kTemporaryStoreHint));
   }
   store.registerForSignalCleanup();
   testStopPoint("render-store");
