@@ -55,13 +55,15 @@ bool transparentHugePagesAvailable() {
 
 FirstTouchSeconds measureFirstTouch(std::size_t bytes) {
   FirstTouchSeconds s;
+  s.bytes = bytes;
   s.plainPages = touchFresh(bytes, false);
   s.hugePages = touchFresh(bytes, true);
   return s;
 }
 
 bool hugePagesWorthAdvising(const FirstTouchSeconds& measured) {
-  return measured.plainPages > 0 && measured.hugePages > 0 && 2 * measured.hugePages <= measured.plainPages;
+  const bool plainSlow = double(measured.bytes) < kSlowFirstTouchBytesPerSecond * measured.plainPages;
+  return plainSlow && measured.hugePages > 0 && 2 * measured.hugePages <= measured.plainPages;
 }
 
 std::optional<bool> hugePagePolicyFromEnvironment(const char* value) {

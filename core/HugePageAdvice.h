@@ -6,7 +6,16 @@
 // on the other, 1.03 s in 4 KiB pages and 0.03 to 0.7 s advised, where advising made a 20 M
 // particle convert plus first image twice as fast. Neither choice suits both, so a command
 // that allocates large buffers measures both kinds of first touch once, on a few megabytes,
-// and advises only where huge pages were the faster (chooseHugePageAdvice).
+// and advises only where plain pages fill slowly (under kSlowFirstTouchBytesPerSecond) and
+// huge pages were at least twice as fast (chooseHugePageAdvice).
+//
+// Why the speed of plain pages decides, not only the ratio: on the first kind of VM a probe of a
+// few megabytes finds huge pages 5x faster (they come from blocks freed lately), while a buffer
+// of hundreds of megabytes draws blocks the host must back again, at 0.4 to 0.9 GB/s against
+// plain pages' 3 GB/s (160 MB: 182 to 440 ms advised, 55 ms plain). Advice can save at most what
+// plain pages cost, so it is worth that risk only where they fill slower than such blocks do.
+// There (2026-12-06), the peer's 20 M particle convert took 705 to 753 ms without advice and
+// 686 to 1003 ms (median 896) with the probe's advice, eight runs each, alternating.
 //
 // FLIPSCOPE_HUGE_PAGES=on|off|auto (default auto: measure) overrides the measurement.
 #pragma once
@@ -34,14 +43,20 @@ void adviseHugePages(void* p, std::size_t bytes);
 /// (/sys/kernel/mm/transparent_hugepage/enabled says [never], or is missing).
 bool transparentHugePagesAvailable();
 
+/// Plain pages filling faster than this (bytes a second) get no advice: 1 GB/s, between the
+/// 0.4 GB/s of the VM where advice pays and the 3 GB/s of the one where it does not.
+inline constexpr double kSlowFirstTouchBytesPerSecond = 1e9;
+
 /// The first touch of `bytes` of fresh memory, in seconds: in 4 KiB pages, and advised.
 struct FirstTouchSeconds {
+  std::size_t bytes = 0;
   double plainPages = 0;
   double hugePages = 0;
 };
 FirstTouchSeconds measureFirstTouch(std::size_t bytes);
 
-/// Advice on when huge pages touch at most half as long as 4 KiB pages.
+/// Advice on when 4 KiB pages fill slower than kSlowFirstTouchBytesPerSecond and huge pages
+/// touch at most half as long.
 bool hugePagesWorthAdvising(const FirstTouchSeconds& measured);
 
 /// FLIPSCOPE_HUGE_PAGES's value: true (on), false (off), nullopt (auto or unset). Throws
