@@ -93,9 +93,6 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& 
   if (separateValues) out.values.resize(base + n);
   std::uint64_t* keys = out.cellKeys.data() + base;
   float* values = separateValues ? out.values.data() + base : nullptr;
-  const std::uint64_t *keysX = grid.axisKeys[0].data(), *keysY = grid.axisKeys[1].data(),
-                      *keysZ = grid.axisKeys[2].data();
-
   // Fixed blocks, each compacted in place by its own task; skipped particles close up after.
   struct Tally {
     std::size_t kept = 0;
@@ -104,41 +101,52 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& 
   };
   constexpr std::size_t kBlock = 1 << 14;
   std::vector<Tally> tallies((n + kBlock - 1) / kBlock);
-  // Locals, not the grid's members: the compiler need not load them again after each key stored.
-  const glm::dvec3 origin = grid.header.origin, limit(grid.cells);
-  const double inverseCell = grid.invCellSize;
-  const std::optional<Box> clip = grid.clip;
-  const bool valueInKey = grid.valueInKey;
   tbb::parallel_for(std::size_t(0), tallies.size(), [&](std::size_t b) {
+    // The loop's inputs as the task's locals, not the grid's members nor the closure's
+    // references: the compiler need not load them again (twice, through a reference) after
+    // each key stored.
+    const glm::vec3* positions = chunk.positions.data();
+    // Speed, the default attribute, inline: attributeValue is a call and a switch a particle.
+    const glm::vec3* velocities = kind == AttributeKind::Speed ? chunk.velocities.data() : nullptr;
+    const float* typeValues = types ? types->values.data() : nullptr;
+    const std::uint64_t *keysX = grid.axisKeys[0].data(), *keysY = grid.axisKeys[1].data(),
+                        *keysZ = grid.axisKeys[2].data();
+    std::uint64_t* const keyOut = keys;
+    float* const valueOut = values;
+    const glm::dvec3 origin = grid.header.origin, limit(grid.cells);
+    const double inverseCell = grid.invCellSize;
+    const bool clipped = grid.clip.has_value();
+    const Box clip = grid.clip.value_or(Box{});
+    const bool valueInKey = grid.valueInKey, withAttribute = attribute;
     Tally t;
     const std::size_t begin = b * kBlock, end = std::min(n, begin + kBlock);
     std::size_t to = begin;
     for (std::size_t i = begin; i != end; ++i) {
-      const glm::vec3 p = chunk.positions[i];
+      const glm::vec3 p = positions[i];
       if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
         ++t.invalid;
         continue;
       }
       const glm::dvec3 q(p);
       const glm::dvec3 c = fastFloor((q - origin) * inverseCell);
-      if ((clip && !clip->contains(q)) || c.x < 0 || c.y < 0 || c.z < 0 || c.x >= limit.x || c.y >= limit.y ||
+      if ((clipped && !clip.contains(q)) || c.x < 0 || c.y < 0 || c.z < 0 || c.x >= limit.x || c.y >= limit.y ||
           c.z >= limit.z) {
         ++t.outside;
         continue;
       }
       const glm::uvec3 cell(c);
       const std::uint64_t cellKey = keysX[cell.x] | keysY[cell.y] | keysZ[cell.z];
-      const std::uint64_t particleKind = types ? std::uint64_t(kindOfTypeValue(types->values[i])) : 0;
-      const float s = attribute ? attributeValue(chunk, kind, i) : 0.0f;
-      if (attribute && std::isfinite(s)) {
+      const std::uint64_t particleKind = typeValues ? std::uint64_t(kindOfTypeValue(typeValues[i])) : 0;
+      const float s = velocities ? glm::length(velocities[i]) : withAttribute ? attributeValue(chunk, kind, i) : 0.0f;
+      if (withAttribute && std::isfinite(s)) {
         t.valueMin = std::min(t.valueMin, s);
         t.valueMax = std::max(t.valueMax, s);
       }
       if (valueInKey) {
-        keys[to] = (((particleKind << kPackedCellBits) | cellKey) << 32) | std::bit_cast<std::uint32_t>(s);
+        keyOut[to] = (((particleKind << kPackedCellBits) | cellKey) << 32) | std::bit_cast<std::uint32_t>(s);
       } else {
-        keys[to] = (particleKind << kKindShift) | cellKey;
-        if (values) values[to] = s;
+        keyOut[to] = (particleKind << kKindShift) | cellKey;
+        if (valueOut) valueOut[to] = s;
       }
       ++to;
     }
