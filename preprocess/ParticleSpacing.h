@@ -46,7 +46,12 @@
 
 namespace flipscope {
 
-inline constexpr std::size_t kSpacingSample = 20000;
+/// The neighbour estimate's sample. Its median's sampling error is a few tenths of a percent at
+/// this size, a tenth of the method's own 2 %: against 20000 (until 2026-12-06) the estimate moved
+/// 0.055 % on the 20 M particle synth frame and 0.02 % on the 100 M one, while the spacing pass
+/// of the 20 M PLY took 0.10 s instead of 0.15 s (the sample's reads, its own search and the
+/// lists are fixed costs; 10000: 0.12 s).
+inline constexpr std::size_t kSpacingSample = 5000;
 inline constexpr int kSpacingNeighbour = 12;
 inline constexpr int kSpacingMaxPasses = 6;
 
