@@ -137,8 +137,8 @@ struct EncodedBrick {
 /// each key is read: the bricks are those of the binning keys (binningKey), without a pass over
 /// every key that makes them first, except where the values lie beside the keys. Frees the
 /// batch's values; its keys are left in another order. Memory: keys + twice the threads'
-/// count of compressed payloads. `sink` runs on any one thread at a time; the brick it is
-/// given is valid only during the call.
+/// count of compressed payloads + a block of 64 Ki keys a thread. `sink` runs on any one thread at a time; the brick it
+/// is given is valid only during the call.
 void binKeys(KeyBatch& batch, const KeyGrid& grid, float min, float max, int zstdLevel,
              const std::function<void(const EncodedBrick&)>& sink);
 

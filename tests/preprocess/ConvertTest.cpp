@@ -76,13 +76,14 @@ struct Case {
   std::uint32_t brickSize;
   double cellSize;
   bool attribute;
+  std::size_t particles = 20000;
 };
 
 class ConvertOracle : public ::testing::TestWithParam<Case> {};
 
 TEST_P(ConvertOracle, StoreMatchesBruteForceBinning) {
   const Case c = GetParam();
-  auto positions = testing::randomParticles(20000, 1000 + c.brickSize, 12.0f);
+  auto positions = testing::randomParticles(c.particles, 1000 + c.brickSize, 12.0f);
   positions[17] = {std::nanf(""), 1, 1};
   positions[18] = {1, std::numeric_limits<float>::infinity(), 1};
   positions[19] = {-5, 1, 1};  // outside the domain below
@@ -142,10 +143,11 @@ TEST_P(ConvertOracle, StoreMatchesBruteForceBinning) {
 
 // With an attribute, 64 and 0.02 (600 cells) make 30-bit cell keys, which carry their values
 // (KeyGrid::valueInKey), and 128 and 0.01 (1200 cells) 33-bit ones, which do not. 32 and 0.004
-// (94 bricks an axis) make 21-bit brick codes: the split by brick takes two digits.
+// (94 bricks an axis) make 21-bit brick codes: split in stripes, not blocks, in two digits.
+// 150000 particles are three blocks of the split by brick (BrickBinning.cpp's kBlockKeys).
 INSTANTIATE_TEST_SUITE_P(BrickSizes, ConvertOracle,
                          ::testing::Values(Case{32, 0.05, false}, Case{64, 0.02, true}, Case{128, 0.01, true},
-                                           Case{32, 0.5, true}, Case{32, 0.004, true}));
+                                           Case{32, 0.5, true}, Case{32, 0.004, true}, Case{32, 0.05, true, 150000}));
 
 // The 16-bit attribute code, against values worked out by hand (the oracle above shares the
 // converter's quantizeAttribute, so it cannot catch a rounding or range bug).
