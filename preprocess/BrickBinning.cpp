@@ -1,11 +1,12 @@
 // Binning of particle keys into encoded bricks (layout in BrickBinning.h).
-// Sorting: each block of 64 Ki keys is sorted by its brick Morton codes (a counting sort through
-// a block-sized buffer, in the cache), so a brick's keys are a run in each block that has some;
-// codes longer than 16 bits (more than 32 bricks along an axis) instead go through an in-place
-// MSD radix sort in 16-bit digits (American flag sort) in a stripe of the keys per task. Then per
-// brick either a cell histogram (dense bricks) or a comparison sort (sparse bricks). Nothing the
-// size of the keys is allocated, because fresh memory is what binning pays most for: on the
-// virtual machines of farms and clouds the first touch of a page costs more than the sort's moves.
+// Sorting: each block of 64 Ki keys (more for grids of over 2 Ki bricks) is sorted by its
+// brick Morton codes (a counting sort through a block-sized buffer, in the cache), so a brick's
+// keys are a run in each block that has some; grids of more than 32 Ki bricks or 64 along an axis
+// instead go through an in-place MSD radix sort in 16-bit digits (American flag sort) in a
+// stripe of the keys per task. Then per brick either a cell histogram (dense bricks) or a
+// comparison sort (sparse bricks). Nothing the size of the keys is allocated, because fresh
+// memory is what binning pays most for: on the virtual machines of farms and clouds the first
+// touch of a page costs more than the sort's moves.
 #include "preprocess/BrickBinning.h"
 
 #include <tbb/blocked_range.h>
@@ -304,12 +305,22 @@ constexpr std::size_t kMaxStripes = 8;
 /// Keys a stripe holds at least.
 constexpr std::size_t kStripeKeys = std::size_t(1) << 20;
 
-/// Keys a block holds (splitBlocksByBrick): 512 KiB, which with its copy sorted by brick stays
-/// in a core's L2 cache.
+/// Keys a block holds at least (splitBlocksByBrick): 512 KiB, which with its copy sorted by
+/// brick stays in a core's L2 cache.
 constexpr std::size_t kBlockKeys = std::size_t(1) << 16;
-/// Brick codes of at most this many bits are split by blocks (a counter a code, 256 KiB a
-/// thread); longer ones (grids of more than 32 bricks along an axis) by stripes.
-constexpr std::uint32_t kBlockSplitCodeBits = 16;
+/// A block holds at least this many keys a brick of the grid, so that its runs, one a brick it
+/// holds, take at most 24 / 32 bytes a key (CodedRun) whatever the particles' order.
+constexpr std::size_t kBlockKeysPerBrick = 32;
+/// Grids of at most this many bricks, whose brick codes have at most kBlockSplitCodeBits bits (a
+/// counter a code: 1 MiB a thread), are split by blocks (of up to 1 Mi keys, 8 MiB); others (a
+/// larger or a long, thin grid) by stripes, in place.
+constexpr std::uint64_t kBlockSplitBricks = std::uint64_t(1) << 15;
+constexpr std::uint32_t kBlockSplitCodeBits = 18;
+
+/// The keys of a block for a grid of `bricks` bricks: kBlockKeys, or more for large grids.
+std::size_t blockKeysFor(std::uint64_t bricks) {
+  return std::max(kBlockKeys, std::bit_ceil(std::size_t(bricks) * kBlockKeysPerBrick));
+}
 
 /// A run of the keys with one brick code.
 struct CodedRun {
@@ -317,16 +328,16 @@ struct CodedRun {
   BrickRun run;
 };
 
-/// Sorts each block of kBlockKeys keys by brick code (`codeBits` bits from `lowBit`), in
+/// Sorts each block of `blockKeys` keys by brick code (`codeBits` bits from `lowBit`), in
 /// parallel: a count of each code, then every key copied to its code's place in a block-sized
 /// buffer and back. Appends one run per code of each block, blocks in order, codes ascending
 /// within a block. Each key is read three times and written twice, all within the cache, where
 /// the in-place split (splitByBrick) swaps each key once into a place anywhere in its stripe:
 /// a miss a key. On the 20 M particle PLY's 20 M keys that split was 14 % of the convert.
 void splitBlocksByBrick(std::uint64_t* keys, std::size_t n, std::uint32_t lowBit, std::uint32_t codeBits,
-                        std::vector<CodedRun>& runs) {
+                        std::size_t blockKeys, std::vector<CodedRun>& runs) {
   const std::uint64_t mask = (std::uint64_t(1) << codeBits) - 1;
-  const std::size_t blocks = (n + kBlockKeys - 1) / kBlockKeys;
+  const std::size_t blocks = (n + blockKeys - 1) / blockKeys;
   std::vector<std::vector<CodedRun>> blockRuns(blocks);
   tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
     thread_local UninitializedVector<std::uint64_t> sorted;
@@ -336,8 +347,8 @@ void splitBlocksByBrick(std::uint64_t* keys, std::size_t n, std::uint32_t lowBit
     if (!countsZero) std::fill(counts.begin(), counts.end(), 0u);
     countsZero = false;
     counts.resize(std::size_t(1) << codeBits);
-    std::uint64_t* const block = keys + b * kBlockKeys;
-    const std::size_t size = std::min(kBlockKeys, n - b * kBlockKeys);
+    std::uint64_t* const block = keys + b * blockKeys;
+    const std::size_t size = std::min(blockKeys, n - b * blockKeys);
     present.clear();
     for (std::size_t i = 0; i < size; ++i) {
       const auto code = std::uint32_t((block[i] >> lowBit) & mask);
@@ -347,7 +358,7 @@ void splitBlocksByBrick(std::uint64_t* keys, std::size_t n, std::uint32_t lowBit
     std::uint32_t offset = 0;
     for (std::uint32_t code : present) {
       const std::uint32_t count = counts[code];
-      blockRuns[b].push_back({code, {b * kBlockKeys + offset, b * kBlockKeys + offset + count}});
+      blockRuns[b].push_back({code, {b * blockKeys + offset, b * blockKeys + offset + count}});
       counts[code] = offset;  // now the code's next place
       offset += count;
     }
@@ -538,8 +549,10 @@ void binKeys(KeyBatch& keyBatch, const KeyGrid& grid, float min, float max, int 
   // A brick's keys end up in runs, of the blocks or of the stripes (decodeRun does not need them
   // in one piece, nor in order).
   std::vector<CodedRun> coded;
-  if (grid.codeBits <= kBlockSplitCodeBits) {
-    splitBlocksByBrick(keys.data(), keys.size(), lowBit, grid.codeBits, coded);
+  const glm::u64vec3 brickGrid(grid.header.brickGrid);
+  const std::uint64_t gridBricks = brickGrid.x * brickGrid.y * brickGrid.z;
+  if (gridBricks <= kBlockSplitBricks && grid.codeBits <= kBlockSplitCodeBits) {
+    splitBlocksByBrick(keys.data(), keys.size(), lowBit, grid.codeBits, blockKeysFor(gridBricks), coded);
   } else {
     // The in-place split moves keys one at a time: stripes of the keys are split on their own,
     // in parallel.

@@ -131,14 +131,15 @@ struct EncodedBrick {
   UninitializedVector<std::byte> payload;
 };
 
-/// Sorts the keys of `batch` by brick in place (in stripes, see BrickBinning.cpp), groups them
-/// and encodes each brick, with a kind per cell when the store has kinds; calls `sink` in
+/// Sorts the keys of `batch` by brick (a block of them at a time, see BrickBinning.cpp), groups
+/// them and encodes each brick, with a kind per cell when the store has kinds; calls `sink` in
 /// ascending Morton order. The attribute is quantized over [min, max] (quantizeAttribute) as
 /// each key is read: the bricks are those of the binning keys (binningKey), without a pass over
 /// every key that makes them first, except where the values lie beside the keys. Frees the
-/// batch's values; its keys are left in another order. Memory: keys + twice the threads'
-/// count of compressed payloads + a block of 64 Ki keys a thread. `sink` runs on any one thread at a time; the brick it
-/// is given is valid only during the call.
+/// batch's values; its keys are left in another order. Memory: the keys; twice the threads'
+/// count of compressed payloads; a block of keys a thread (64 Ki, more for grids of over 2 Ki
+/// bricks, at most 1 Mi); and a run a brick in each block, at most 24 bytes a 32 keys. `sink`
+/// runs on any one thread at a time; the brick it is given is valid only during the call.
 void binKeys(KeyBatch& batch, const KeyGrid& grid, float min, float max, int zstdLevel,
              const std::function<void(const EncodedBrick&)>& sink);
 

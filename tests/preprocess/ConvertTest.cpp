@@ -144,10 +144,12 @@ TEST_P(ConvertOracle, StoreMatchesBruteForceBinning) {
 // With an attribute, 64 and 0.02 (600 cells) make 30-bit cell keys, which carry their values
 // (KeyGrid::valueInKey), and 128 and 0.01 (1200 cells) 33-bit ones, which do not. 32 and 0.004
 // (94 bricks an axis) make 21-bit brick codes: split in stripes, not blocks, in two digits.
-// 150000 particles are three blocks of the split by brick (BrickBinning.cpp's kBlockKeys).
+// 150000 particles are three blocks of the split by brick (BrickBinning.cpp's kBlockKeys); 32
+// and 0.015 make 25^3 bricks, whose blocks hold 512 Ki keys (kBlockKeysPerBrick).
 INSTANTIATE_TEST_SUITE_P(BrickSizes, ConvertOracle,
                          ::testing::Values(Case{32, 0.05, false}, Case{64, 0.02, true}, Case{128, 0.01, true},
-                                           Case{32, 0.5, true}, Case{32, 0.004, true}, Case{32, 0.05, true, 150000}));
+                                           Case{32, 0.5, true}, Case{32, 0.004, true}, Case{32, 0.05, true, 150000},
+                                           Case{32, 0.015, true}));
 
 // The 16-bit attribute code, against values worked out by hand (the oracle above shares the
 // converter's quantizeAttribute, so it cannot catch a rounding or range bug).
