@@ -1,8 +1,9 @@
 // Binning of particle keys into encoded bricks (layout in BrickBinning.h).
-// Sorting: each block of 64 Ki keys (more for grids of over 2 Ki bricks) is sorted by its
-// brick Morton codes (a counting sort through a block-sized buffer, in the cache), so a brick's
-// keys are a run in each block that has some; grids of more than 32 Ki bricks or 64 along an axis
-// instead go through an in-place MSD radix sort in 16-bit digits (American flag sort) in a
+// Sorting by brick Morton code, a block of keys at a time (a counting sort through a buffer in
+// the cache), so a brick's keys are a run in each block that has some: on grids of at most 512
+// bricks, computeKeys sorts each task's 16 Ki keys as it makes them; else binKeys sorts blocks of
+// 64 Ki keys (more for grids of over 2 Ki bricks). Grids of more than 32 Ki bricks or 64 along an
+// axis instead go through an in-place MSD radix sort in 16-bit digits (American flag sort) in a
 // stripe of the keys per task. Then per brick either a cell histogram (dense bricks) or a
 // comparison sort (sparse bricks). Nothing the size of the keys is allocated, because fresh
 // memory is what binning pays most for: on the virtual machines of farms and clouds the first
@@ -51,6 +52,64 @@ KeyGrid::KeyGrid(const StoreHeader& h, std::optional<Box> clipBox)
     }
   }
 }
+
+namespace {
+
+/// Keys a block holds at least (splitBlocksByBrick): 512 KiB, which with its copy sorted by
+/// brick stays in a core's L2 cache.
+constexpr std::size_t kBlockKeys = std::size_t(1) << 16;
+/// A block sorted by brick holds at least this many keys a brick of the grid, so that its runs,
+/// one a brick it holds, take at most 24 / 32 bytes a key (CodedRun) whatever the particles'
+/// order.
+constexpr std::size_t kBlockKeysPerBrick = 32;
+/// Grids of at most this many bricks, whose brick codes have at most kBlockSplitCodeBits bits (a
+/// counter a code: 1 MiB a thread), are sorted by blocks (of up to 1 Mi keys, 8 MiB); others (a
+/// larger or a long, thin grid) split by stripes, in place.
+constexpr std::uint64_t kBlockSplitBricks = std::uint64_t(1) << 15;
+constexpr std::uint32_t kBlockSplitCodeBits = 18;
+
+std::uint64_t gridBricks(const KeyGrid& grid) {
+  const glm::u64vec3 bricks(grid.header.brickGrid);
+  return bricks.x * bricks.y * bricks.z;
+}
+
+/// Sorts block[0, size) by brick code (`codeBits` bits from `lowBit`): a count of each code,
+/// then every key copied to its code's place in a buffer of the thread's and back. Appends one
+/// run per code, ascending, at `first` plus its place in the block. Each key is read three times
+/// and written twice, all within the cache, where the in-place split (splitByBrick) swaps each
+/// key once into a place anywhere in its stripe: a miss a key. On the 20 M particle PLY's 20 M
+/// keys that split was 14 % of the convert.
+void sortBlockByBrick(std::uint64_t* block, std::size_t size, std::size_t first, std::uint32_t lowBit,
+                      std::uint32_t codeBits, std::vector<CodedRun>& runs) {
+  const std::uint64_t mask = (std::uint64_t(1) << codeBits) - 1;
+  thread_local UninitializedVector<std::uint64_t> sorted;
+  thread_local std::vector<std::uint32_t> counts;  // zero between blocks
+  thread_local std::vector<std::uint32_t> present;
+  thread_local bool countsZero = true;  // false only where a block threw before its reset
+  if (!countsZero) std::fill(counts.begin(), counts.end(), 0u);
+  countsZero = false;
+  counts.resize(std::size_t(1) << codeBits);
+  present.clear();
+  for (std::size_t i = 0; i < size; ++i) {
+    const auto code = std::uint32_t((block[i] >> lowBit) & mask);
+    if (counts[code]++ == 0) present.push_back(code);
+  }
+  std::sort(present.begin(), present.end());
+  std::uint32_t offset = 0;
+  for (std::uint32_t code : present) {
+    const std::uint32_t count = counts[code];
+    runs.push_back({code, {first + offset, first + offset + count}});
+    counts[code] = offset;  // now the code's next place
+    offset += count;
+  }
+  sorted.resize(size);
+  for (std::size_t i = 0; i < size; ++i) sorted[counts[std::uint32_t((block[i] >> lowBit) & mask)]++] = block[i];
+  std::memcpy(block, sorted.data(), size * sizeof(std::uint64_t));
+  for (std::uint32_t code : present) counts[code] = 0;
+  countsZero = true;
+}
+
+}  // namespace
 
 float attributeValue(const ParticleChunk& chunk, AttributeKind kind, std::size_t i) {
   switch (kind) {
@@ -104,6 +163,12 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& 
   };
   constexpr std::size_t kBlock = 1 << 14;
   std::vector<Tally> tallies((n + kBlock - 1) / kBlock);
+  // On grids of few bricks, each block's keys are sorted by brick while they are in the cache,
+  // and their runs kept (KeyBatch::runs), unless the batch holds other keys or will be spilled.
+  const bool sortBlocks = out.sortRuns && out.sortedKeys == base && !separateValues &&
+                          grid.codeBits <= kBlockSplitCodeBits && gridBricks(grid) * kBlockKeysPerBrick <= kBlock;
+  const std::uint32_t codeShift = grid.cellKeyShift() + grid.cellBits;
+  std::vector<std::vector<CodedRun>> blockRuns(sortBlocks ? tallies.size() : 0);
   tbb::parallel_for(std::size_t(0), tallies.size(), [&](std::size_t b) {
     // The loop's inputs as the task's locals, not the grid's members nor the closure's
     // references: the compiler need not load them again (twice, through a reference) after
@@ -155,6 +220,7 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& 
     }
     t.kept = to - begin;
     tallies[b] = t;
+    if (sortBlocks) sortBlockByBrick(keys + begin, t.kept, 0, codeShift, grid.codeBits, blockRuns[b]);
   });
 
   KeyTally result;
@@ -165,6 +231,9 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& 
       std::memmove(keys + kept, keys + b * kBlock, t.kept * sizeof(*keys));
       if (values) std::memmove(values + kept, values + b * kBlock, t.kept * sizeof(*values));
     }
+    if (sortBlocks)
+      for (const CodedRun& r : blockRuns[b])
+        out.runs.push_back({r.code, {base + kept + r.run.begin, base + kept + r.run.end}});
     kept += t.kept;
     result.invalid += t.invalid;
     result.outside += t.outside;
@@ -175,6 +244,7 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& 
     }
   }
   result.kept = kept;
+  if (sortBlocks) out.sortedKeys = base + kept;
   out.cellKeys.resize(base + kept);
   if (values) out.values.resize(base + kept);
   return result;
@@ -237,10 +307,6 @@ void makeBinningKeys(KeyBatch& batch, const KeyGrid& grid, float min, float max)
 
 constexpr std::uint32_t kDigitBits = 16;
 constexpr std::size_t kParallelThreshold = 1 << 16;
-
-struct BrickRun {
-  std::size_t begin, end;
-};
 
 /// Sorts keys[begin,end) in place by the bits [lowBit, highBit) (the brick code), most
 /// significant digit first (American flag sort: a histogram, then each key swapped into its
@@ -305,68 +371,20 @@ constexpr std::size_t kMaxStripes = 8;
 /// Keys a stripe holds at least.
 constexpr std::size_t kStripeKeys = std::size_t(1) << 20;
 
-/// Keys a block holds at least (splitBlocksByBrick): 512 KiB, which with its copy sorted by
-/// brick stays in a core's L2 cache.
-constexpr std::size_t kBlockKeys = std::size_t(1) << 16;
-/// A block holds at least this many keys a brick of the grid, so that its runs, one a brick it
-/// holds, take at most 24 / 32 bytes a key (CodedRun) whatever the particles' order.
-constexpr std::size_t kBlockKeysPerBrick = 32;
-/// Grids of at most this many bricks, whose brick codes have at most kBlockSplitCodeBits bits (a
-/// counter a code: 1 MiB a thread), are split by blocks (of up to 1 Mi keys, 8 MiB); others (a
-/// larger or a long, thin grid) by stripes, in place.
-constexpr std::uint64_t kBlockSplitBricks = std::uint64_t(1) << 15;
-constexpr std::uint32_t kBlockSplitCodeBits = 18;
-
 /// The keys of a block for a grid of `bricks` bricks: kBlockKeys, or more for large grids.
 std::size_t blockKeysFor(std::uint64_t bricks) {
   return std::max(kBlockKeys, std::bit_ceil(std::size_t(bricks) * kBlockKeysPerBrick));
 }
 
-/// A run of the keys with one brick code.
-struct CodedRun {
-  std::uint64_t code;
-  BrickRun run;
-};
-
-/// Sorts each block of `blockKeys` keys by brick code (`codeBits` bits from `lowBit`), in
-/// parallel: a count of each code, then every key copied to its code's place in a block-sized
-/// buffer and back. Appends one run per code of each block, blocks in order, codes ascending
-/// within a block. Each key is read three times and written twice, all within the cache, where
-/// the in-place split (splitByBrick) swaps each key once into a place anywhere in its stripe:
-/// a miss a key. On the 20 M particle PLY's 20 M keys that split was 14 % of the convert.
+/// Sorts each block of `blockKeys` keys by brick code (sortBlockByBrick), in parallel. Appends
+/// the runs, blocks in order.
 void splitBlocksByBrick(std::uint64_t* keys, std::size_t n, std::uint32_t lowBit, std::uint32_t codeBits,
                         std::size_t blockKeys, std::vector<CodedRun>& runs) {
-  const std::uint64_t mask = (std::uint64_t(1) << codeBits) - 1;
   const std::size_t blocks = (n + blockKeys - 1) / blockKeys;
   std::vector<std::vector<CodedRun>> blockRuns(blocks);
   tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
-    thread_local UninitializedVector<std::uint64_t> sorted;
-    thread_local std::vector<std::uint32_t> counts;  // zero between blocks
-    thread_local std::vector<std::uint32_t> present;
-    thread_local bool countsZero = true;  // false only where a block threw before its reset
-    if (!countsZero) std::fill(counts.begin(), counts.end(), 0u);
-    countsZero = false;
-    counts.resize(std::size_t(1) << codeBits);
-    std::uint64_t* const block = keys + b * blockKeys;
-    const std::size_t size = std::min(blockKeys, n - b * blockKeys);
-    present.clear();
-    for (std::size_t i = 0; i < size; ++i) {
-      const auto code = std::uint32_t((block[i] >> lowBit) & mask);
-      if (counts[code]++ == 0) present.push_back(code);
-    }
-    std::sort(present.begin(), present.end());
-    std::uint32_t offset = 0;
-    for (std::uint32_t code : present) {
-      const std::uint32_t count = counts[code];
-      blockRuns[b].push_back({code, {b * blockKeys + offset, b * blockKeys + offset + count}});
-      counts[code] = offset;  // now the code's next place
-      offset += count;
-    }
-    sorted.resize(size);
-    for (std::size_t i = 0; i < size; ++i) sorted[counts[std::uint32_t((block[i] >> lowBit) & mask)]++] = block[i];
-    std::memcpy(block, sorted.data(), size * sizeof(std::uint64_t));
-    for (std::uint32_t code : present) counts[code] = 0;
-    countsZero = true;
+    sortBlockByBrick(keys + b * blockKeys, std::min(blockKeys, n - b * blockKeys), b * blockKeys, lowBit, codeBits,
+                     blockRuns[b]);
   });
   for (const auto& r : blockRuns) runs.insert(runs.end(), r.begin(), r.end());
 }
@@ -549,10 +567,10 @@ void binKeys(KeyBatch& keyBatch, const KeyGrid& grid, float min, float max, int 
   // A brick's keys end up in runs, of the blocks or of the stripes (decodeRun does not need them
   // in one piece, nor in order).
   std::vector<CodedRun> coded;
-  const glm::u64vec3 brickGrid(grid.header.brickGrid);
-  const std::uint64_t gridBricks = brickGrid.x * brickGrid.y * brickGrid.z;
-  if (gridBricks <= kBlockSplitBricks && grid.codeBits <= kBlockSplitCodeBits) {
-    splitBlocksByBrick(keys.data(), keys.size(), lowBit, grid.codeBits, blockKeysFor(gridBricks), coded);
+  if (keyBatch.sortedKeys == keys.size() && !grid.valuesBesideKeys()) {
+    coded = std::move(keyBatch.runs);  // computeKeys sorted them already
+  } else if (gridBricks(grid) <= kBlockSplitBricks && grid.codeBits <= kBlockSplitCodeBits) {
+    splitBlocksByBrick(keys.data(), keys.size(), lowBit, grid.codeBits, blockKeysFor(gridBricks(grid)), coded);
   } else {
     // The in-place split moves keys one at a time: stripes of the keys are split on their own,
     // in parallel.

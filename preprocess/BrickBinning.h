@@ -63,6 +63,16 @@ inline constexpr std::uint64_t kCellKeyMask = (1ull << kKindShift) - 1;
 /// Bits of a cell key below the kind in a batch key that carries its value (KeyGrid::valueInKey).
 inline constexpr std::uint32_t kPackedCellBits = 30;
 
+/// Keys [begin, end) of a batch.
+struct BrickRun {
+  std::size_t begin, end;
+};
+/// A run of a batch's keys with one brick code.
+struct CodedRun {
+  std::uint64_t code;
+  BrickRun run;
+};
+
 using KeyVector = UninitializedVector<std::uint64_t>;
 using ValueVector = UninitializedVector<float>;
 
@@ -76,9 +86,19 @@ using ValueVector = UninitializedVector<float>;
 struct KeyBatch {
   KeyVector cellKeys;
   ValueVector values;
+  /// Where computeKeys() left the keys sorted by brick code a block at a time (grids of few
+  /// bricks, values in the keys): runs of one code each, which cover cellKeys[0, sortedKeys),
+  /// a block's runs in ascending code. binKeys() then need not sort them by brick again; keys
+  /// added any other way (a spill bucket's) leave sortedKeys short of cellKeys.size().
+  std::vector<CodedRun> runs;
+  std::size_t sortedKeys = 0;
+  /// Whether computeKeys() sorts and keeps runs (not for keys that go to spill files).
+  bool sortRuns = true;
   void clear() {
     cellKeys.clear();
     values.clear();
+    runs.clear();
+    sortedKeys = 0;
   }
 };
 
@@ -103,7 +123,9 @@ ParticleKind kindOfTypeValue(float flags);
 /// Appends the batch keys of `chunk` to `out` (parallel over the chunk, deterministic order),
 /// with the values of the store's attribute (attributeValue) when it has one. With `types` (a
 /// column of chunk, arity 1: the particles' type flags), each key carries the particle's kind
-/// (kindOfTypeValue); without, none (liquid).
+/// (kindOfTypeValue); without, none (liquid). On grids of at most 512 bricks whose values lie in
+/// the keys, each block of 16 Ki particles' keys is sorted by brick and its runs kept
+/// (KeyBatch::runs), where `out` asks for them and holds no other keys.
 KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& out,
                      const AttributeColumn* types = nullptr);
 

@@ -264,7 +264,9 @@ class FrameBinner {
         mPlan(plan),
         mOptions(options),
         mScratch(std::move(scratchDir)),
-        mPrefix(std::string(kSpillPrefix) + std::to_string(::getpid()) + "-" + std::to_string(frame)) {}
+        mPrefix(std::string(kSpillPrefix) + std::to_string(::getpid()) + "-" + std::to_string(frame)) {
+    mBatch.sortRuns = false;  // the spill files take its keys in any order
+  }
 
   /// With particle kinds, the chunk's last column holds the type flags (convertFrame).
   void add(const ParticleChunk& chunk) {
