@@ -13,9 +13,11 @@
 // few megabytes finds huge pages 5x faster (they come from blocks freed lately), while a buffer
 // of hundreds of megabytes draws blocks the host must back again, at 0.4 to 0.9 GB/s against
 // plain pages' 3 GB/s (160 MB: 182 to 440 ms advised, 55 ms plain). Advice can save at most what
-// plain pages cost, so it is worth that risk only where they fill slower than such blocks do.
-// There (2026-12-06), the peer's 20 M particle convert took 705 to 753 ms without advice and
-// 686 to 1003 ms (median 896) with the probe's advice, eight runs each, alternating.
+// plain pages cost, so it is worth that risk only where they are slow: 1 GB/s lies between the
+// 0.4 GB/s of the VM where it paid and the 3 GB/s of the one where it did not. There
+// (2026-12-06), the peer's 20 M particle convert took 705 to 753 ms without advice and 686 to
+// 1003 ms (median 896) with the probe's advice, eight runs each, alternating. Each kind is
+// probed twice and its faster time kept, so one preemption does not decide.
 //
 // FLIPSCOPE_HUGE_PAGES=on|off|auto (default auto: measure) overrides the measurement.
 #pragma once
@@ -47,7 +49,8 @@ bool transparentHugePagesAvailable();
 /// 0.4 GB/s of the VM where advice pays and the 3 GB/s of the one where it does not.
 inline constexpr double kSlowFirstTouchBytesPerSecond = 1e9;
 
-/// The first touch of `bytes` of fresh memory, in seconds: in 4 KiB pages, and advised.
+/// The first touch of `bytes` of fresh memory, in seconds: in 4 KiB pages, and advised (each the
+/// faster of two).
 struct FirstTouchSeconds {
   std::size_t bytes = 0;
   double plainPages = 0;

@@ -1,13 +1,14 @@
 // Binning of particle keys into encoded bricks (layout in BrickBinning.h).
 // Sorting by brick Morton code, a block of keys at a time (a counting sort through a buffer in
-// the cache), so a brick's keys are a run in each block that has some: on grids of at most 512
-// bricks, computeKeys sorts each task's 16 Ki keys as it makes them; else binKeys sorts blocks of
-// 64 Ki keys (more for grids of over 2 Ki bricks). Grids of more than 32 Ki bricks or 64 along an
+// the cache), so a brick's keys are a run in each block that has some: computeKeys sorts each
+// task's 16 Ki keys as it makes them where the grid has at most 512 bricks and 64 along an axis
+// and the values lie in the keys (and the keys are not spilled); else binKeys sorts blocks of 64
+// Ki keys (more for grids of over 2 Ki bricks). Grids of more than 32 Ki bricks or 64 along an
 // axis instead go through an in-place MSD radix sort in 16-bit digits (American flag sort) in a
 // stripe of the keys per task. Then per brick either a cell histogram (dense bricks) or a
-// comparison sort (sparse bricks). Nothing the size of the keys is allocated, because fresh
-// memory is what binning pays most for: on the virtual machines of farms and clouds the first
-// touch of a page costs more than the sort's moves.
+// comparison sort (sparse bricks). Nothing is allocated in proportion to the keys but their runs
+// (at most 24 bytes a 32 keys), because fresh memory is what binning pays most for: on the
+// virtual machines of farms and clouds the first touch of a page costs more than the sort's moves.
 #include "preprocess/BrickBinning.h"
 
 #include <tbb/blocked_range.h>
@@ -58,10 +59,9 @@ namespace {
 /// Keys a block holds at least (splitBlocksByBrick): 512 KiB, which with its copy sorted by
 /// brick stays in a core's L2 cache.
 constexpr std::size_t kBlockKeys = std::size_t(1) << 16;
-/// A block sorted by brick holds at least this many keys a brick of the grid, so that its runs,
-/// one a brick it holds, take at most 24 / 32 bytes a key (CodedRun) whatever the particles'
-/// order.
-constexpr std::size_t kBlockKeysPerBrick = 32;
+/// A block sorted by brick in binKeys holds at least this many keys a brick of the grid, so that
+/// its runs, one a brick it holds, are at most one per kKeysPerRun keys whatever the order.
+constexpr std::size_t kBlockKeysPerBrick = kKeysPerRun;
 /// Grids of at most this many bricks, whose brick codes have at most kBlockSplitCodeBits bits (a
 /// counter a code: 1 MiB a thread), are sorted by blocks (of up to 1 Mi keys, 8 MiB); others (a
 /// larger or a long, thin grid) split by stripes, in place.
@@ -76,11 +76,13 @@ std::uint64_t gridBricks(const KeyGrid& grid) {
 /// Sorts block[0, size) by brick code (`codeBits` bits from `lowBit`): a count of each code,
 /// then every key copied to its code's place in a buffer of the thread's and back. Appends one
 /// run per code, ascending, at `first` plus its place in the block. Each key is read three times
-/// and written twice, all within the cache, where the in-place split (splitByBrick) swaps each
-/// key once into a place anywhere in its stripe: a miss a key. On the 20 M particle PLY's 20 M
-/// keys that split was 14 % of the convert.
+/// and written twice, within the cache for blocks of up to 64 Ki keys, where the in-place split
+/// (splitByBrick) swaps each key once into a place anywhere in its stripe: a miss a key. On the
+/// 20 M particle PLY's 20 M keys that split was 14 % of the convert. The thread keeps its buffer
+/// (8 bytes a key of its largest block) and counters (4 bytes a code) for the next block.
 void sortBlockByBrick(std::uint64_t* block, std::size_t size, std::size_t first, std::uint32_t lowBit,
                       std::uint32_t codeBits, std::vector<CodedRun>& runs) {
+  if (size == 0) return;
   const std::uint64_t mask = (std::uint64_t(1) << codeBits) - 1;
   thread_local UninitializedVector<std::uint64_t> sorted;
   thread_local std::vector<std::uint32_t> counts;  // zero between blocks
@@ -166,7 +168,7 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& 
   // On grids of few bricks, each block's keys are sorted by brick while they are in the cache,
   // and their runs kept (KeyBatch::runs), unless the batch holds other keys or will be spilled.
   const bool sortBlocks = out.sortRuns && out.sortedKeys == base && !separateValues &&
-                          grid.codeBits <= kBlockSplitCodeBits && gridBricks(grid) * kBlockKeysPerBrick <= kBlock;
+                          grid.codeBits <= kBlockSplitCodeBits && gridBricks(grid) * kKeysPerRun <= kBlock;
   const std::uint32_t codeShift = grid.cellKeyShift() + grid.cellBits;
   std::vector<std::vector<CodedRun>> blockRuns(sortBlocks ? tallies.size() : 0);
   tbb::parallel_for(std::size_t(0), tallies.size(), [&](std::size_t b) {
@@ -244,7 +246,13 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& 
     }
   }
   result.kept = kept;
-  if (sortBlocks) out.sortedKeys = base + kept;
+  // Blocks thinned by skipped particles, or short (small chunks under a small --mem), can hold a
+  // run for few keys: past one per kKeysPerRun keys (plus one a brick), no runs are kept.
+  if (sortBlocks && out.runs.size() <= (base + kept) / kKeysPerRun + gridBricks(grid)) {
+    out.sortedKeys = base + kept;
+  } else if (sortBlocks) {
+    std::vector<CodedRun>().swap(out.runs);  // out.sortedKeys stays short: binKeys sorts the keys
+  }
   out.cellKeys.resize(base + kept);
   if (values) out.values.resize(base + kept);
   return result;
@@ -392,10 +400,10 @@ void splitBlocksByBrick(std::uint64_t* keys, std::size_t n, std::uint32_t lowBit
 /// The keys of one brick: its runs (of the blocks, or of the stripes, that hold some).
 struct BrickParts {
   std::uint64_t code = 0;
-  std::span<const BrickRun> runs;
+  std::span<const CodedRun> runs;  ///< in binKeys' list, each of this code
   std::size_t keys() const {
     std::size_t n = 0;
-    for (const BrickRun& r : runs) n += r.end - r.begin;
+    for (const CodedRun& r : runs) n += r.run.end - r.run.begin;
     return n;
   }
 };
@@ -483,12 +491,13 @@ void decodeRun(std::uint64_t* all, const BrickParts& parts, const KeyGrid& grid,
   const auto attributeOf = [&](std::uint64_t key) { return fields.attributeOf(key); };
   const std::size_t total = parts.keys();
   auto forEachKey = [&](auto f) {
-    for (const BrickRun& run : parts.runs)
-      for (std::size_t i = run.begin; i != run.end; ++i) f(all[i]);
+    for (const CodedRun& r : parts.runs)
+      for (std::size_t i = r.run.begin; i != r.run.end; ++i) f(all[i]);
   };
   if (total * 16 < cellsPerBrick) {
     // Sparse: sort the binning keys, (cell, attribute), directly.
-    std::span<std::uint64_t> keys(all + parts.runs[0].begin, parts.runs[0].end - parts.runs[0].begin);
+    const BrickRun& first = parts.runs[0].run;
+    std::span<std::uint64_t> keys(all + first.begin, first.end - first.begin);
     if (parts.runs.size() > 1 || fields.layout != KeyFields::Layout::Binning) {
       gathered.clear();
       forEachKey([&](std::uint64_t k) { gathered.push_back(fields.binningKeyOf(k)); });
@@ -568,7 +577,7 @@ void binKeys(KeyBatch& keyBatch, const KeyGrid& grid, float min, float max, int 
   // in one piece, nor in order).
   std::vector<CodedRun> coded;
   if (keyBatch.sortedKeys == keys.size() && !grid.valuesBesideKeys()) {
-    coded = std::move(keyBatch.runs);  // computeKeys sorted them already
+    coded.swap(keyBatch.runs);  // computeKeys sorted them already
   } else if (gridBricks(grid) <= kBlockSplitBricks && grid.codeBits <= kBlockSplitCodeBits) {
     splitBlocksByBrick(keys.data(), keys.size(), lowBit, grid.codeBits, blockKeysFor(gridBricks(grid)), coded);
   } else {
@@ -585,13 +594,15 @@ void binKeys(KeyBatch& keyBatch, const KeyGrid& grid, float min, float max, int 
     for (const auto& runs : stripeRuns)
       for (const BrickRun& run : runs) coded.push_back({(keys[run.begin] >> lowBit) & codeMask, run});
   }
-  // Ascending codes, and a brick's runs in key order: a merge of the blocks' or stripes' runs.
-  std::stable_sort(coded.begin(), coded.end(), [](const CodedRun& a, const CodedRun& b) { return a.code < b.code; });
-  std::vector<BrickRun> runs(coded.size());
+  keyBatch.runs.clear();  // used or stale: a second call on this batch sorts the keys itself
+  keyBatch.sortedKeys = 0;
+  // Ascending codes, a brick's runs in key order (the runs do not overlap: a total order).
+  std::sort(coded.begin(), coded.end(), [](const CodedRun& a, const CodedRun& b) {
+    return a.code != b.code ? a.code < b.code : a.run.begin < b.run.begin;
+  });
   std::vector<BrickParts> bricks;
   for (std::size_t i = 0; i < coded.size(); ++i) {
-    runs[i] = coded[i].run;
-    if (bricks.empty() || bricks.back().code != coded[i].code) bricks.push_back({coded[i].code, {&runs[i], 0}});
+    if (bricks.empty() || bricks.back().code != coded[i].code) bricks.push_back({coded[i].code, {&coded[i], 0}});
     bricks.back().runs = {bricks.back().runs.data(), bricks.back().runs.size() + 1};
   }
 

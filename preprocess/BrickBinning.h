@@ -72,6 +72,9 @@ struct CodedRun {
   std::uint64_t code;
   BrickRun run;
 };
+/// Sorting by brick a block at a time keeps at most one run per this many keys (plus one a brick
+/// of the grid): 24 bytes a 32 keys, whatever the particles' order (BrickBinning.cpp).
+inline constexpr std::size_t kKeysPerRun = 32;
 
 using KeyVector = UninitializedVector<std::uint64_t>;
 using ValueVector = UninitializedVector<float>;
@@ -86,10 +89,10 @@ using ValueVector = UninitializedVector<float>;
 struct KeyBatch {
   KeyVector cellKeys;
   ValueVector values;
-  /// Where computeKeys() left the keys sorted by brick code a block at a time (grids of few
-  /// bricks, values in the keys): runs of one code each, which cover cellKeys[0, sortedKeys),
-  /// a block's runs in ascending code. binKeys() then need not sort them by brick again; keys
-  /// added any other way (a spill bucket's) leave sortedKeys short of cellKeys.size().
+  /// Where computeKeys() left the keys sorted by brick code a block at a time (see its
+  /// contract): runs of one code each, which cover cellKeys[0, sortedKeys), a block's runs in
+  /// ascending code. binKeys() then need not sort them by brick again; keys added any other way
+  /// (a spill bucket's) leave sortedKeys short of cellKeys.size().
   std::vector<CodedRun> runs;
   std::size_t sortedKeys = 0;
   /// Whether computeKeys() sorts and keeps runs (not for keys that go to spill files).
@@ -123,9 +126,11 @@ ParticleKind kindOfTypeValue(float flags);
 /// Appends the batch keys of `chunk` to `out` (parallel over the chunk, deterministic order),
 /// with the values of the store's attribute (attributeValue) when it has one. With `types` (a
 /// column of chunk, arity 1: the particles' type flags), each key carries the particle's kind
-/// (kindOfTypeValue); without, none (liquid). On grids of at most 512 bricks whose values lie in
-/// the keys, each block of 16 Ki particles' keys is sorted by brick and its runs kept
-/// (KeyBatch::runs), where `out` asks for them and holds no other keys.
+/// (kindOfTypeValue); without, none (liquid). On grids of at most 512 bricks and 64 along an
+/// axis whose values lie in the keys, each block of 16 Ki particles' keys is sorted by brick and
+/// its runs kept (KeyBatch::runs), where `out` asks for them (sortRuns) and its keys so far are
+/// all sorted; not where the runs would pass one per kKeysPerRun keys (plus one a brick): then
+/// `out` keeps no runs, and binKeys() sorts its keys.
 KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& out,
                      const AttributeColumn* types = nullptr);
 
@@ -153,15 +158,18 @@ struct EncodedBrick {
   UninitializedVector<std::byte> payload;
 };
 
-/// Sorts the keys of `batch` by brick (a block of them at a time, see BrickBinning.cpp), groups
-/// them and encodes each brick, with a kind per cell when the store has kinds; calls `sink` in
-/// ascending Morton order. The attribute is quantized over [min, max] (quantizeAttribute) as
-/// each key is read: the bricks are those of the binning keys (binningKey), without a pass over
-/// every key that makes them first, except where the values lie beside the keys. Frees the
-/// batch's values; its keys are left in another order. Memory: the keys; twice the threads'
-/// count of compressed payloads; a block of keys a thread (64 Ki, more for grids of over 2 Ki
-/// bricks, at most 1 Mi); and a run a brick in each block, at most 24 bytes a 32 keys. `sink`
-/// runs on any one thread at a time; the brick it is given is valid only during the call.
+/// Sorts the keys of `batch` by brick (a block of them at a time, see BrickBinning.cpp), unless
+/// computeKeys() did (KeyBatch::runs), groups them and encodes each brick, with a kind per cell
+/// when the store has kinds; calls `sink` in ascending Morton order. The attribute is quantized
+/// over [min, max] (quantizeAttribute) as each key is read: the bricks are those of the binning
+/// keys (binningKey), without a pass over every key that makes them first, except where the
+/// values lie beside the keys. Frees the batch's values and runs; its keys are left in another
+/// order. Memory: the keys; twice the threads' count of compressed payloads; the runs, 24 bytes
+/// each, at most one per kKeysPerRun keys (plus one a brick) when sorted by blocks, at most one
+/// a brick in each of 8 stripes otherwise; and, kept by each thread for the next call, a block of
+/// keys (64 Ki, more for grids of over 2 Ki bricks, at most 1 Mi: 8 MiB) and a counter a brick
+/// code (at most 1 MiB). `sink` runs on any one thread at a time; the brick it is given is valid
+/// only during the call.
 void binKeys(KeyBatch& batch, const KeyGrid& grid, float min, float max, int zstdLevel,
              const std::function<void(const EncodedBrick&)>& sink);
 

@@ -69,7 +69,9 @@ void stopPoint(const char* point) {
 /// Memory plan of one conversion, all derived from the budget.
 struct MemoryPlan {
   explicit MemoryPlan(std::uint64_t budget, bool separateValues) {
-    const std::uint64_t perParticle = separateValues ? 12 : 8;  // key (+ value): binning sorts in place
+    // Key (+ value): binning sorts in place. Its runs (at most 24 bytes a detail::kKeysPerRun
+    // keys: 5.6 % of the budget at most) and its per-thread blocks fit in what keys leave.
+    const std::uint64_t perParticle = separateValues ? 12 : 8;
     // At most 256 Ki particles a chunk (6 MiB of positions and velocities; two chunks are in
     // flight with read-ahead): the 20 M particle PLY of `bench render --peer embree` converted in
     // 0.67-0.70 s with chunks of 256 Ki, 0.69-0.71 s with 512 Ki, 0.70-1.00 s with 1 Mi (their
@@ -287,6 +289,7 @@ class FrameBinner {
           std::min(mPlan.maxBinParticles, mExpectedParticles.value_or(mPlan.maxBinParticles)) + mPlan.chunkParticles;
       mKeys.cellKeys.reserve(keys);
       if (mValues) mKeys.values.reserve(keys);
+      mKeys.runs.reserve(keys / detail::kKeysPerRun + 1);  // untouched unless computeKeys sorts
     }
     account(detail::computeKeys(chunk, mGrid, mKeys, types));
     if (mKeys.cellKeys.size() > mPlan.maxBinParticles) startSpilling();
@@ -328,6 +331,7 @@ class FrameBinner {
     mSpill = std::make_unique<SpillBuckets>(mScratch, mPrefix, shift, bits, mValues, mPlan.spillBufferBytes);
     mSpill->add(mKeys.cellKeys.data(), mKeys.values.data(), mKeys.cellKeys.size());
     mKeys.clear();
+    std::vector<detail::CodedRun>().swap(mKeys.runs);  // the buckets loaded into mKeys have none
     mSpillBuckets += std::uint32_t(mSpill->size());
   }
 

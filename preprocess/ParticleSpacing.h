@@ -25,12 +25,11 @@
 // Cost of the neighbour estimate: one read of the source when it has at most kSpacingSample
 // particles or seeks to a particle (raw, binary PLY: the sample costs kSpacingSample small
 // reads, asked of the disk all at once), else two (rarely more); memory O(kSpacingSample) plus one chunk of particles,
-// plus at most about 25 MiB, whatever the frame's size, for the search's cells near the sample (about 5 MiB for the
-// 20 M particle synth frame): at most 4 MiB of bits and 2 MiB of their ranks and, per cell within the search radius of
-// a sampled particle (at most 64 each), the list of those particles; where the sample lies far apart (two tanks, a
-// particle flung far away), instead of the ranks, up to 20 MiB of (cell, particle) pairs while the lists of cells of
-// the radius are made. The time stays about that of a read of the frame however far apart its particles lie. The
-// source is rewound afterwards.
+// plus at most about 25 MiB, whatever the frame's size, for the search's cells near the sample: at most 4 MiB of bits
+// and 2 MiB of their ranks and, per cell within the search radius of a sampled particle (at most 64 each), the list of
+// those particles; where the sample lies far apart (two tanks, a particle flung far away), instead of the ranks, up to
+// 20 MiB of (cell, particle) pairs while the lists of cells of the radius are made. The time stays about that of a read
+// of the frame however far apart its particles lie. The source is rewound afterwards.
 #pragma once
 
 #include <cstddef>

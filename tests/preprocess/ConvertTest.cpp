@@ -1,6 +1,7 @@
 // Binning (convertFrame) against a brute-force oracle, and out-of-core against in-core.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -144,12 +145,14 @@ TEST_P(ConvertOracle, StoreMatchesBruteForceBinning) {
 // With an attribute, 64 and 0.02 (600 cells) make 30-bit cell keys, which carry their values
 // (KeyGrid::valueInKey), and 128 and 0.01 (1200 cells) 33-bit ones, which do not. 32 and 0.004
 // (94 bricks an axis) make 21-bit brick codes: split in stripes, not blocks, in two digits.
-// 150000 particles are three blocks of the split by brick (BrickBinning.cpp's kBlockKeys); 32
-// and 0.015 make 25^3 bricks, whose blocks hold 512 Ki keys (kBlockKeysPerBrick).
+// With 150000 particles, 32 and 0.05 (8^3 bricks) have computeKeys sort its blocks, the first of
+// them thinned by the skipped particles; 32 and 0.04 (10^3 bricks) have binKeys sort three blocks
+// of 64 Ki keys; with 600000, 32 and 0.015 (25^3 bricks) two blocks of 512 Ki
+// (BrickBinning.cpp's kBlockKeys and kBlockKeysPerBrick).
 INSTANTIATE_TEST_SUITE_P(BrickSizes, ConvertOracle,
                          ::testing::Values(Case{32, 0.05, false}, Case{64, 0.02, true}, Case{128, 0.01, true},
                                            Case{32, 0.5, true}, Case{32, 0.004, true}, Case{32, 0.05, true, 150000},
-                                           Case{32, 0.015, true}));
+                                           Case{32, 0.04, true, 150000}, Case{32, 0.015, true, 600000}));
 
 // The 16-bit attribute code, against values worked out by hand (the oracle above shares the
 // converter's quantizeAttribute, so it cannot catch a rounding or range bug).
@@ -170,30 +173,39 @@ TEST(Convert, AttributeQuantizationByHand) {
       }
 }
 
-/// Brick size and cell size of a store over [0, 50)^3, and whether its batch keys carry their
-/// attribute values (KeyBatch's two layouts, also in the spill files).
+/// Brick size and cell size of a store over [0, 50)^3 stretched by `stretch`, whether its batch
+/// keys carry their attribute values (KeyBatch's two layouts, also in the spill files), and the
+/// case's name.
 struct OutOfCoreCase {
   std::uint32_t brickSize;
   double cellSize;
   bool valueInKey;
+  const char* name;
+  glm::vec3 stretch{1.0f};
+  /// Particles in order along x, as a solver's cache often is (near particles near in the file):
+  /// then a block of keys touches few bricks, and computeKeys keeps its runs.
+  bool alongX = false;
 };
 
 class ConvertOutOfCore : public ::testing::TestWithParam<OutOfCoreCase> {};
 
 TEST_P(ConvertOutOfCore, StoreIsByteIdenticalToInCoreWithAndWithoutReadAhead) {
   // ~2.4 M particles (29 MB of float32, 58 MB with velocities) against a 4 MiB budget. Neither
-  // budget's chunk (174762 and 4096 particles) divides the count. In core, binning splits the
-  // keys by brick in two stripes (binKeys: a stripe per task from 2^20 keys on), so bricks come
-  // in two runs.
+  // budget's chunk (174762 and 4096 particles) divides the count. The keys are sorted by brick
+  // a block at a time: in core by computeKeys on the grid of 512 bricks, by binKeys on the others
+  // (spilled keys always by binKeys); on the long, thin grid (125 bricks along x) split in place
+  // in stripes instead, one a task from 2^20 keys on, so in core its bricks come in two runs.
   const OutOfCoreCase c = GetParam();
   auto positions = testing::randomParticles(2400000, 77, 50.0f);
+  for (glm::vec3& p : positions) p *= c.stretch;
+  if (c.alongX) std::sort(positions.begin(), positions.end(), [](const auto& a, const auto& b) { return a.x < b.x; });
   std::vector<glm::vec3> velocities(positions.size());
   for (std::size_t i = 0; i < positions.size(); ++i) velocities[i] = glm::vec3(std::sin(float(i)), 0.5f, 0);
   ConvertOptions options;
   options.cellSize = c.cellSize;
   options.brickSize = c.brickSize;
   options.progress = Progress::Mode::Silent;
-  const Box domain{{0, 0, 0}, {50, 50, 50}};
+  const Box domain{{0, 0, 0}, glm::dvec3(50.0f * c.stretch)};
   ASSERT_EQ(detail::KeyGrid(makeStoreHeader(domain, options, AttributeKind::Speed)).valueInKey, c.valueInKey);
   testing::TempDir temp("out-of-core");
   auto run = [&](std::uint64_t budget, const std::string& name, bool readAhead = true, bool hintsCount = true,
@@ -207,7 +219,7 @@ TEST_P(ConvertOutOfCore, StoreIsByteIdenticalToInCoreWithAndWithoutReadAhead) {
     testing::VectorSource source(positions, velocities);
     source.hintsCount = hintsCount;
     source.wrongCount = wrongCount;
-    tbb::task_arena arena(4);  // as many stripes as tasks, whatever the cores here
+    tbb::task_arena arena(4);  // as many stripes as tasks, whatever the cores here (in stripes)
     FrameReport report = arena.execute([&] { return convertFrame(source, store, 1, options); });
     return std::make_pair(dir, report);
   };
@@ -246,10 +258,71 @@ TEST_P(ConvertOutOfCore, StoreIsByteIdenticalToInCoreWithAndWithoutReadAhead) {
 }
 
 // 1000 cells of 64: 30 bits of cell key, the value rides in the key; 2500 cells of 128: 36 bits,
-// the value travels beside it.
-INSTANTIATE_TEST_SUITE_P(KeyLayouts, ConvertOutOfCore,
-                         ::testing::Values(OutOfCoreCase{64, 0.05, true}, OutOfCoreCase{128, 0.02, false}),
-                         [](const auto& info) { return info.param.valueInKey ? "ValueInKey" : "ValueBesideKey"; });
+// the value travels beside it; 500 cells of 64: 8^3 bricks, few enough for computeKeys to sort
+// its keys (and keep their runs: the particles in order along x); 4000 by 80 by 80 cells of 32 (200 x 4 x 4): 125 x 3 x
+// 3 bricks, split in stripes.
+INSTANTIATE_TEST_SUITE_P(
+    KeyLayouts, ConvertOutOfCore,
+    ::testing::Values(OutOfCoreCase{64, 0.05, true, "ValueInKey"}, OutOfCoreCase{128, 0.02, false, "ValueBesideKey"},
+                      OutOfCoreCase{64, 0.1, true, "FewBricksSortedAsKeysAreMade", glm::vec3(1.0f), true},
+                      OutOfCoreCase{32, 0.05, false, "LongThinGridInStripes", {4.0f, 0.08f, 0.08f}}),
+    [](const auto& info) { return std::string(info.param.name); });
+
+// computeKeys keeps the runs of its sorted blocks only while they stay within one per
+// kKeysPerRun keys (plus one a brick), whatever the particles' order: particles in random order
+// over 8^3 bricks touch every brick in every block of 16 Ki, and a small chunk (a small --mem)
+// is one short block; in order along x, a block touches a slab of bricks.
+TEST(Convert, KeysSortedAsTheyAreMadeKeepTheirRunsOnlyWithinTheirBound) {
+  ConvertOptions options;
+  options.cellSize = 0.1;
+  options.brickSize = 64;
+  const StoreHeader header = makeStoreHeader(Box{{0, 0, 0}, {50, 50, 50}}, options, AttributeKind::Speed);
+  const detail::KeyGrid grid(header);
+  ASSERT_EQ(header.brickGrid, glm::uvec3(8));
+  ASSERT_TRUE(grid.valueInKey);
+  ParticleChunk chunk;
+  chunk.positions = testing::randomParticles(200000, 3, 50.0f);
+  chunk.velocities.assign(chunk.positions.size(), glm::vec3(1, 0, 0));
+  const auto keysOf = [&](const ParticleChunk& c, std::size_t from, std::size_t count) {
+    ParticleChunk part;
+    part.positions.assign(c.positions.begin() + std::ptrdiff_t(from),
+                          c.positions.begin() + std::ptrdiff_t(from + count));
+    part.velocities.assign(count, glm::vec3(1, 0, 0));
+    return part;
+  };
+  const auto withinBound = [&](const detail::KeyBatch& batch) {
+    return batch.runs.size() <= batch.cellKeys.size() / detail::kKeysPerRun + 512;
+  };
+  detail::KeyBatch random;
+  for (std::size_t from = 0; from < chunk.size(); from += 50000)
+    detail::computeKeys(keysOf(chunk, from, 50000), grid, random);
+  EXPECT_LT(random.sortedKeys, random.cellKeys.size());  // binKeys sorts them
+  EXPECT_TRUE(random.runs.empty()) << random.runs.size() << " runs";
+  detail::KeyBatch small;  // chunks of 4096 keys: each one short block with a run a brick
+  for (std::size_t from = 0; from < 40960; from += 4096) detail::computeKeys(keysOf(chunk, from, 4096), grid, small);
+  EXPECT_LT(small.sortedKeys, small.cellKeys.size());
+  EXPECT_TRUE(withinBound(small));
+  std::sort(chunk.positions.begin(), chunk.positions.end(), [](const auto& a, const auto& b) { return a.x < b.x; });
+  detail::KeyBatch ordered;
+  for (std::size_t from = 0; from < chunk.size(); from += 50000)
+    detail::computeKeys(keysOf(chunk, from, 50000), grid, ordered);
+  EXPECT_EQ(ordered.sortedKeys, ordered.cellKeys.size());
+  EXPECT_TRUE(withinBound(ordered)) << ordered.runs.size() << " runs";
+  // The runs cover every key once, each of one brick code, a block's codes ascending.
+  std::size_t covered = 0;
+  for (const detail::CodedRun& r : ordered.runs) {
+    covered += r.run.end - r.run.begin;
+    for (std::size_t i = r.run.begin; i < r.run.end; ++i)
+      ASSERT_EQ((ordered.cellKeys[i] >> (32 + grid.cellBits)) & ((1u << grid.codeBits) - 1), r.code) << i;
+  }
+  EXPECT_EQ(covered, ordered.cellKeys.size());
+  // Spilled keys are not sorted.
+  detail::KeyBatch spilled;
+  spilled.sortRuns = false;
+  detail::computeKeys(keysOf(chunk, 0, 50000), grid, spilled);
+  EXPECT_EQ(spilled.sortedKeys, 0u);
+  EXPECT_TRUE(spilled.runs.empty());
+}
 
 TEST(Convert, SkewedDataSplitsBucketsRecursively) {
   // Most particles in one corner brick region: the first-level bucket overflows.
