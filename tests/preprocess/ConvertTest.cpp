@@ -146,13 +146,13 @@ TEST_P(ConvertOracle, StoreMatchesBruteForceBinning) {
 // (KeyGrid::valueInKey), and 128 and 0.01 (1200 cells) 33-bit ones, which do not. 32 and 0.004
 // (94 bricks an axis) make 21-bit brick codes: split in stripes, not blocks, in two digits.
 // With 150000 particles, 32 and 0.05 (8^3 bricks) have computeKeys sort its blocks, the first of
-// them thinned by the skipped particles; 32 and 0.04 (10^3 bricks) have binKeys sort three blocks
-// of 64 Ki keys; with 600000, 32 and 0.015 (25^3 bricks) two blocks of 512 Ki
+// them thinned by the skipped particles; 32 and 0.04 (10^3 bricks) have binKeys sort three
+// blocks of 64 Ki keys; with 300000, 32 and 0.0234375 (17^3 bricks) two blocks of 256 Ki
 // (BrickBinning.cpp's kBlockKeys and kBlockKeysPerBrick).
 INSTANTIATE_TEST_SUITE_P(BrickSizes, ConvertOracle,
                          ::testing::Values(Case{32, 0.05, false}, Case{64, 0.02, true}, Case{128, 0.01, true},
                                            Case{32, 0.5, true}, Case{32, 0.004, true}, Case{32, 0.05, true, 150000},
-                                           Case{32, 0.04, true, 150000}, Case{32, 0.015, true, 600000}));
+                                           Case{32, 0.04, true, 150000}, Case{32, 0.0234375, true, 300000}));
 
 // The 16-bit attribute code, against values worked out by hand (the oracle above shares the
 // converter's quantizeAttribute, so it cannot catch a rounding or range bug).
