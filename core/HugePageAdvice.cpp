@@ -54,17 +54,26 @@ bool transparentHugePagesAvailable() {
   return std::getline(in, modes) && modes.find("[never]") == std::string::npos;
 }
 
+namespace {
+bool plainPagesSlow(std::size_t bytes, double seconds) {
+  return double(bytes) < kSlowFirstTouchBytesPerSecond * seconds;
+}
+}  // namespace
+
 FirstTouchSeconds measureFirstTouch(std::size_t bytes) {
   FirstTouchSeconds s;
   s.bytes = bytes;
-  s.plainPages = std::min(touchFresh(bytes, false), touchFresh(bytes, false));
+  s.plainPages = touchFresh(bytes, false);
+  // A preemption can only slow a probe: plain pages that look slow get a second look (fast ones,
+  // no advice whatever the rest, need none at each command's start).
+  if (plainPagesSlow(bytes, s.plainPages)) s.plainPages = std::min(s.plainPages, touchFresh(bytes, false));
   s.hugePages = std::min(touchFresh(bytes, true), touchFresh(bytes, true));
   return s;
 }
 
 bool hugePagesWorthAdvising(const FirstTouchSeconds& measured) {
-  const bool plainSlow = double(measured.bytes) < kSlowFirstTouchBytesPerSecond * measured.plainPages;
-  return plainSlow && measured.hugePages > 0 && 2 * measured.hugePages <= measured.plainPages;
+  return plainPagesSlow(measured.bytes, measured.plainPages) && measured.hugePages > 0 &&
+         2 * measured.hugePages <= measured.plainPages;
 }
 
 std::optional<bool> hugePagePolicyFromEnvironment(const char* value) {

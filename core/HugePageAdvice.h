@@ -16,8 +16,9 @@
 // plain pages cost, so it is worth that risk only where they are slow: 1 GB/s lies between the
 // 0.4 GB/s of the VM where it paid and the 3 GB/s of the one where it did not. There
 // (2026-12-06), the peer's 20 M particle convert took 705 to 753 ms without advice and 686 to
-// 1003 ms (median 896) with the probe's advice, eight runs each, alternating. Each kind is
-// probed twice and its faster time kept, so one preemption does not decide.
+// 1003 ms (median 896) with the probe's advice, eight runs each, alternating. Huge pages are
+// probed twice, and plain pages again where they look slow, the faster time kept, so one
+// preemption does not decide.
 //
 // FLIPSCOPE_HUGE_PAGES=on|off|auto (default auto: measure) overrides the measurement.
 #pragma once
@@ -49,8 +50,8 @@ bool transparentHugePagesAvailable();
 /// 0.4 GB/s of the VM where advice pays and the 3 GB/s of the one where it does not.
 inline constexpr double kSlowFirstTouchBytesPerSecond = 1e9;
 
-/// The first touch of `bytes` of fresh memory, in seconds: in 4 KiB pages, and advised (each the
-/// faster of two).
+/// The first touch of `bytes` of fresh memory, in seconds: in 4 KiB pages (the faster of two
+/// where the first is under kSlowFirstTouchBytesPerSecond), and advised (the faster of two).
 struct FirstTouchSeconds {
   std::size_t bytes = 0;
   double plainPages = 0;
