@@ -80,14 +80,18 @@ struct MemoryPlan {
     maxBinParticles = std::max<std::uint64_t>(budget * 6 / 10 / perParticle, 1 << 16);
     // An eighth of the budget buffers the spill files: up to 256 of up to 1 MiB (direct writes of
     // 64 KiB ran at half the disk's speed of 1 MiB ones here).
-    spillBufferBytes =
-        std::clamp<std::uint64_t>(budget / 8 / 256 / detail::kDirectBlock, 16, 256) * detail::kDirectBlock;
+    spillBufferBytes = std::clamp<std::uint64_t>(budget / 8 / 256 / kDirectBlock, 16, 256) * kDirectBlock;
     maxBucketFiles = std::clamp<std::uint64_t>(budget / 8 / spillBufferBytes, 2, 256);
+    // A sixteenth reads the input ahead of binning, around the page cache (the binning pass's
+    // ReadOptions::readOnceAheadBytes), one file at a time and until its end: at least the two
+    // pieces of DirectReadAhead (4 MiB, more than a sixteenth under --mem 64M), at most 32 MiB.
+    readAheadBytes = std::clamp<std::uint64_t>(budget / 16, 4 << 20, 32 << 20);
   }
   std::uint64_t chunkParticles;   ///< particles read at once
   std::uint64_t maxBinParticles;  ///< particles binned in memory at once
   std::uint64_t maxBucketFiles;   ///< spill files open at once
   std::uint64_t spillBufferBytes;  ///< buffer of each, a multiple of kDirectBlock
+  std::uint64_t readAheadBytes;    ///< of the input, by its binning pass
 };
 
 /// Spill record: the batch key (KeyBatch), then the attribute value when it travels beside it.
@@ -156,7 +160,7 @@ class SpillBuckets {
     if (!bucket.records) return;
     detail::DirectFile file(bucket.path, detail::DirectFile::Mode::Read);
     const std::size_t bytes = recordBytes(mValues);
-    detail::AlignedBuffer block(4 * mBufferBytes);  // the spill buffers are free by now (finish())
+    AlignedBuffer block(4 * mBufferBytes);  // the spill buffers are free by now (finish())
     std::vector<std::uint64_t> keys;
     std::vector<float> values;
     std::byte carry[16];  // a record split across two blocks
@@ -215,7 +219,7 @@ class SpillBuckets {
   struct Bucket {
     std::filesystem::path path;
     std::unique_ptr<detail::DirectFile> file;
-    detail::AlignedBuffer buffer;  ///< allocated at the bucket's first record
+    AlignedBuffer buffer;          ///< allocated at the bucket's first record
     std::size_t used = 0;          ///< bytes of buffer not yet written
     std::uint64_t records = 0;
     CleanupOnSignal cleanup;  ///< from before the file exists until it is removed
@@ -223,8 +227,8 @@ class SpillBuckets {
   /// Queues the buffer's whole blocks for writing; at the end (`last`), all of it, its last
   /// block padded. What is left moves to a buffer of its own.
   void flush(Bucket& b, bool last) {
-    const std::size_t whole = last ? (b.used + detail::kDirectBlock - 1) / detail::kDirectBlock * detail::kDirectBlock
-                                   : b.used / detail::kDirectBlock * detail::kDirectBlock;
+    const std::size_t whole =
+        last ? (b.used + kDirectBlock - 1) / kDirectBlock * kDirectBlock : b.used / kDirectBlock * kDirectBlock;
     if (whole == 0) return;
     if (!b.file) {
       const DeferCleanupSignals step;  // registered and created as one step
@@ -232,7 +236,7 @@ class SpillBuckets {
       b.file = std::make_unique<detail::DirectFile>(b.path, detail::DirectFile::Mode::Create);
     }
     if (whole > b.used) std::memset(b.buffer.data() + b.used, 0, whole - b.used);
-    detail::AlignedBuffer rest;
+    AlignedBuffer rest;
     const std::size_t left = last ? 0 : b.used - whole;
     if (!last) {
       rest = mAppender->take();
@@ -1175,7 +1179,9 @@ ConvertReport convert(const std::vector<FrameInput>& inputs, const std::filesyst
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     progress.setLabel("convert frame " + std::to_string(inputs[i].frame) + " (" + std::to_string(i + 1) + "/" +
                       std::to_string(inputs.size()) + ")");
-    auto source = openTypedFrame(inputs[i], reading.read, kinds, kindAttributes[i]);
+    ReadOptions binning = reading.read;  // the frame's last read
+    binning.readOnceAheadBytes = MemoryPlan(reading.memoryBudget, false).readAheadBytes;
+    auto source = openTypedFrame(inputs[i], binning, kinds, kindAttributes[i]);
     report.frames.push_back(convertOneFrame(*source, store, inputs[i].frame, reading, &progress,
                                             framelessHeader ? &*framelessHeader : nullptr));
     framelessHeader.reset();  // kept: the store has a frame

@@ -15,15 +15,6 @@
 
 namespace flipscope::detail {
 
-AlignedBuffer::AlignedBuffer(std::size_t bytes) : mSize((bytes + kDirectBlock - 1) / kDirectBlock * kDirectBlock) {
-  if (mSize == 0) return;
-  auto* p = static_cast<std::byte*>(std::aligned_alloc(kDirectBlock, mSize));
-  if (!p) throw std::bad_alloc();
-  mData.reset(p);
-}
-
-void AlignedBuffer::Free::operator()(std::byte* p) const { std::free(p); }
-
 DirectFile::DirectFile(const std::filesystem::path& path, Mode mode) : mPath(path) {
   const int flags = mode == Mode::Create ? O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC : O_RDONLY | O_CLOEXEC;
   mFd = ::open(path.c_str(), flags | O_DIRECT, 0644);

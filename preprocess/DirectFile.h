@@ -20,26 +20,9 @@
 #include <thread>
 #include <vector>
 
+#include "core/AlignedBuffer.h"
+
 namespace flipscope::detail {
-
-/// Block size of direct I/O: buffer addresses, lengths and file offsets are multiples of it.
-inline constexpr std::size_t kDirectBlock = 4096;
-
-/// A heap buffer aligned to kDirectBlock.
-class AlignedBuffer {
- public:
-  AlignedBuffer() = default;
-  explicit AlignedBuffer(std::size_t bytes);  ///< rounded up to kDirectBlock; contents undefined
-  std::byte* data() const { return mData.get(); }
-  std::size_t size() const { return mSize; }
-
- private:
-  struct Free {
-    void operator()(std::byte* p) const;
-  };
-  std::unique_ptr<std::byte, Free> mData;
-  std::size_t mSize = 0;
-};
 
 class DirectFile {
  public:

@@ -2,6 +2,8 @@
 // counts the sanitizer runs lower through the environment.
 #pragma once
 
+#include <fcntl.h>
+#include <sys/mman.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -11,6 +13,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace flipscope::testing {
 
@@ -20,6 +23,26 @@ inline long positiveCountFromEnvironment(const char* name, long usual) {
   const char* text = std::getenv(name);
   const long asked = text ? std::atol(text) : 0;
   return asked > 0 ? asked : usual;
+}
+
+/// Drops `path`'s pages from the page cache (written back first), as a file read cold from
+/// disk. Whether they left it: not on tmpfs, whose pages are the file. Asked with mincore() over
+/// a mapping never touched.
+inline bool dropFromPageCache(const std::filesystem::path& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return false;
+  ::fdatasync(fd);
+  ::posix_fadvise(fd, 0, 0, POSIX_FADV_DONTNEED);
+  const std::size_t size = std::filesystem::file_size(path), page = 4096, pages = (size + page - 1) / page;
+  bool dropped = false;
+  if (void* map = size ? ::mmap(nullptr, size, PROT_READ, MAP_SHARED, fd, 0) : MAP_FAILED; map != MAP_FAILED) {
+    std::vector<unsigned char> flags(pages);
+    dropped = ::mincore(map, size, flags.data()) == 0;
+    for (unsigned char f : flags) dropped = dropped && !(f & 1);
+    ::munmap(map, size);
+  }
+  ::close(fd);
+  return dropped;
 }
 
 /// A fresh directory under the system temporary directory, removed with its content.

@@ -22,9 +22,8 @@ void dropFromPageCache(const std::vector<std::filesystem::path>& files) {
   }
 }
 
-DiskRead readUncached(const std::vector<std::filesystem::path>& files) {
-  constexpr std::size_t kBlock = 16 << 20;
-  std::unique_ptr<void, decltype(&std::free)> buffer(std::aligned_alloc(4096, kBlock), &std::free);
+DiskRead readUncached(const std::vector<std::filesystem::path>& files, std::size_t blockBytes) {
+  std::unique_ptr<void, decltype(&std::free)> buffer(std::aligned_alloc(4096, blockBytes), &std::free);
   if (!buffer) throw InputError("bench: cannot allocate the read buffer");
   DiskRead result;
   result.direct = true;
@@ -38,7 +37,7 @@ DiskRead readUncached(const std::vector<std::filesystem::path>& files) {
     }
     if (fd < 0) throw FileError(file, "cannot open");
     for (;;) {
-      const ssize_t n = ::read(fd, buffer.get(), kBlock);
+      const ssize_t n = ::read(fd, buffer.get(), blockBytes);
       if (n < 0) {
         ::close(fd);
         throw FileError(file, "read failed");

@@ -3,6 +3,7 @@
 // reader reads them from the disk too.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <vector>
@@ -20,9 +21,9 @@ struct DiskRead {
   double bytesPerSecond() const { return seconds > 0 ? double(bytes) / seconds : 0; }
 };
 
-/// Reads every file once from the disk: with O_DIRECT in 16 MiB aligned reads where the
-/// filesystem allows it, else through the page cache after dropping the files from it.
-/// Throws FileError naming a file that cannot be read.
-DiskRead readUncached(const std::vector<std::filesystem::path>& files);
+/// Reads every file once from the disk: with O_DIRECT in aligned reads of `blockBytes` (a
+/// multiple of 4096) where the filesystem allows it, else through the page cache after dropping
+/// the files from it. Throws FileError naming a file that cannot be read.
+DiskRead readUncached(const std::vector<std::filesystem::path>& files, std::size_t blockBytes = 16 << 20);
 
 }  // namespace flipscope::tools

@@ -1,6 +1,6 @@
 // flipscope bench preprocess: conversion throughput against the raw-read limit and against the
-// disk (the uncached read, then converts in and out of core from a dropped page cache, and one
-// in core given the spacing and the domain the first convert found, so that it reads the input
+// disk (the uncached read, then converts in and out of core from a dropped page cache, each
+// also given the spacing and the domain the first convert found, so that it reads the input
 // once), in one run.
 // Without inputs, a synth frame (raw float32) is generated first (not timed). The input is
 // then read sequentially with plain read() calls (the raw-read limit, warm page cache after
@@ -133,9 +133,12 @@ void runBenchPreprocess(const BenchPreprocessArgs& a) {
   const FrameReport& frame = report.frames.front();
   const std::uint64_t particles = frame.stats.particles + frame.stats.skippedInvalid + frame.stats.skippedOutside;
 
-  // Against the disk (issue 13): the uncached read of the input, then a convert in core and one
-  // out of core, each with the input dropped from the page cache first.
-  const DiskRead disk = readUncached(files);
+  // Against the disk (issue 13): the uncached read of the input, then converts in core and out
+  // of core, each with the input dropped from the page cache first. The disk's speed is the
+  // faster of direct reads of 16 MiB (the issue's `dd iflag=direct bs=16M`) and of 2 MiB (the
+  // size of convert's own, DirectReadAhead.h; the faster on the development VM).
+  const DiskRead disk16 = readUncached(files, 16 << 20), disk2 = readUncached(files, 2 << 20);
+  const DiskRead& disk = disk2.seconds < disk16.seconds ? disk2 : disk16;
   auto fromDisk = [&](std::uint64_t budget, const std::string& name, bool oneRead = false) {
     ConvertOptions cold = options;
     cold.memoryBudget = budget;
@@ -145,6 +148,7 @@ void runBenchPreprocess(const BenchPreprocessArgs& a) {
       cold.domain = Box{report.header.origin, report.header.domainMax()};
     }
     fs::remove_all(work / name);
+    ::sync();  // the last run's writes (its store, its spill files) are not this one's to wait for
     dropFromPageCache(files);
     const auto begin = std::chrono::steady_clock::now();
     const ConvertReport r = convert(inputs, work / name, cold);
@@ -152,10 +156,13 @@ void runBenchPreprocess(const BenchPreprocessArgs& a) {
     fs::remove_all(work / name);
     return std::make_pair(seconds, r.frames.front().spillBuckets > 0);
   };
+  // The out-of-core converts last: the disk was still busy with the removal of their spill files
+  // when the next convert began (the one-read convert took 2.2 s after them, 1.44 s before).
   const auto [coldInCore, coldInCoreSpilled] = fromDisk(options.memoryBudget, "store-cold");
+  const auto [coldOneRead, coldOneReadSpilled] = fromDisk(options.memoryBudget, "store-cold-one-read", true);
   const std::uint64_t outOfCoreBudget = parseBytes("--out-of-core-mem", a.outOfCoreMem);
   const auto [coldOutOfCore, coldSpilled] = fromDisk(outOfCoreBudget, "store-cold-ooc");
-  const auto [coldOneRead, coldOneReadSpilled] = fromDisk(options.memoryBudget, "store-cold-one-read", true);
+  const auto [coldOneReadOutOfCore, coldOneReadOutSpilled] = fromDisk(outOfCoreBudget, "store-cold-one-read-ooc", true);
 
   const double readRate = particles / readSeconds;
   const double convertRate = particles / convertSeconds;
@@ -176,10 +183,13 @@ void runBenchPreprocess(const BenchPreprocessArgs& a) {
                      {"mem_budget_bytes", options.memoryBudget},
                      {"out_of_core", frame.spillBuckets > 0},
                      {"disk_read_s", disk.seconds},
+                     {"disk_read_16m_s", disk16.seconds},
+                     {"disk_read_2m_s", disk2.seconds},
                      {"disk_read_direct", disk.direct},
                      {"convert_from_disk_in_core_s", coldInCore},
                      {"convert_from_disk_out_of_core_s", coldOutOfCore},
                      {"convert_from_disk_one_read_s", coldOneRead},
+                     {"convert_from_disk_one_read_out_of_core_s", coldOneReadOutOfCore},
                      {"out_of_core_mem_bytes", outOfCoreBudget},
                      {"source", source},
                      {"readers", formatResult}};
@@ -195,8 +205,12 @@ void runBenchPreprocess(const BenchPreprocessArgs& a) {
   std::printf("%-34s %10.3f %16s %12.2f\n", frame.spillBuckets ? "convert (out of core)" : "convert (in core)",
               convertSeconds, Progress::humanCount(convertRate).c_str(), ratio);
   std::printf("%-34s %10.3f %16s %12s\n", "paper: 500 M in 12 s (8 cores, SSD)", 12.0, "40.0 M", "disk-bound");
-  std::printf("%-34s %10.3f %16s %12s\n", disk.direct ? "disk read (uncached, O_DIRECT)" : "disk read (pages dropped)",
-              disk.seconds, Progress::humanCount(particles / disk.seconds).c_str(), "");
+  for (const auto& [read, label] : {std::pair(&disk16, "16 MiB"), std::pair(&disk2, "2 MiB")})
+    std::printf(
+        "%-34s %10.3f %16s %12s%s\n",
+        (std::string(read->direct ? "disk read (O_DIRECT, " : "disk read (pages dropped, ") + label + ")").c_str(),
+        read->seconds, Progress::humanCount(particles / read->seconds).c_str(), "",
+        read == &disk ? "   the disk read" : "");
   const std::string inCoreLabel = std::string("convert from disk, ") + (coldInCoreSpilled ? "out of core" : "in core");
   std::printf("%-34s %10.3f %16s %12s   %.2fx the disk read\n", inCoreLabel.c_str(), coldInCore,
               Progress::humanCount(particles / coldInCore).c_str(), "", coldInCore / disk.seconds);
@@ -207,10 +221,15 @@ void runBenchPreprocess(const BenchPreprocessArgs& a) {
       std::string("  one read (spacing, domain given)") + (coldOneReadSpilled ? ", out of core" : "");
   std::printf("%-34s %10.3f %16s %12s   %.2fx the disk read\n", oneReadLabel.c_str(), coldOneRead,
               Progress::humanCount(particles / coldOneRead).c_str(), "", coldOneRead / disk.seconds);
+  const std::string oneReadOutLabel = "  one read, --mem " + a.outOfCoreMem + (coldOneReadOutSpilled ? "" : " (fit)");
+  std::printf("%-34s %10.3f %16s %12s   %.2fx the disk read\n", oneReadOutLabel.c_str(), coldOneReadOutOfCore,
+              Progress::humanCount(particles / coldOneReadOutOfCore).c_str(), "", coldOneReadOutOfCore / disk.seconds);
   std::printf("\ntarget: convert <= 4x raw read (goal 1.5x): %s\n", ratio <= 4 ? "met" : "NOT met");
-  std::printf("target: convert from disk <= 1.25x the disk read, in core %s, out of core %s\n",
-              coldInCore <= 1.25 * disk.seconds ? "met" : "NOT met",
-              coldOutOfCore <= 1.25 * disk.seconds ? "met" : "NOT met");
+  const auto met = [&](double seconds) { return seconds <= 1.25 * disk.seconds ? "met" : "NOT met"; };
+  std::printf(
+      "target: convert from disk <= 1.25x the disk read: in core %s (one read %s), out of core %s (one "
+      "read %s)\n",
+      met(coldInCore), met(coldOneRead), met(coldOutOfCore), met(coldOneReadOutOfCore));
   std::printf("store: %u bricks, %s bytes = %.3f of raw float32 (target <= 0.25): %s\n", frame.bricks,
               Progress::humanCount(double(frame.storeBytes)).c_str(), double(frame.storeBytes) / rawFloatBytes,
               double(frame.storeBytes) / rawFloatBytes <= 0.25 ? "met" : "NOT met");

@@ -8,10 +8,13 @@
 #include <cerrno>
 #include <cstring>
 #include <exception>
+#include <mutex>
+#include <optional>
 #include <thread>
 #include <utility>
 
 #include "core/Error.h"
+#include "preprocess/particles/DirectReadAhead.h"
 
 namespace flipscope {
 namespace {
@@ -20,7 +23,8 @@ constexpr std::size_t kBufferBytes = std::size_t(1) << 20;
 
 class FileByteSource final : public ByteSource {
  public:
-  explicit FileByteSource(const std::filesystem::path& path) : mPath(path) {
+  FileByteSource(const std::filesystem::path& path, std::size_t readOnceAheadBytes)
+      : mPath(path), mReadOnceAheadBytes(readOnceAheadBytes) {
     std::error_code ec;
     auto status = std::filesystem::status(path, ec);
     if (!std::filesystem::exists(status)) throw FileError(path, "no such file");
@@ -35,10 +39,20 @@ class FileByteSource final : public ByteSource {
       throw FileError(path, "cannot read the file size: " + ec.message());
     }
     ::posix_fadvise(mFd, 0, 0, POSIX_FADV_SEQUENTIAL);
+    if (readOnceAheadBytes > 0 && mSize > 0) {
+      mDirectFd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_DIRECT);  // fails where the file system has none
+      if (mDirectFd >= 0) mResidency.emplace(mFd, mSize);
+    }
   }
-  ~FileByteSource() override { ::close(mFd); }
+  ~FileByteSource() override {
+    mStream.reset();  // its threads read from both descriptors
+    if (mDirectFd >= 0) ::close(mDirectFd);
+    ::close(mFd);
+  }
   std::uint64_t size() const override { return mSize; }
   std::size_t readAt(std::uint64_t offset, void* data, std::size_t bytes) override {
+    if (mDirectFd >= 0 && (bytes >= kReadAheadTrigger || offset == mStreamPosition.load(std::memory_order_relaxed)))
+      if (const auto n = readAround(offset, data, bytes)) return *n;
     readAhead(offset, bytes);
     std::size_t done = 0;
     while (done < bytes) {
@@ -58,6 +72,33 @@ class FileByteSource final : public ByteSource {
   }
 
  private:
+  /// A read of a file read once: from the stream around the page cache (DirectReadAhead) that
+  /// the last read left off, whatever its size, or a large one from a new stream where it starts
+  /// the file or continues the last read, and the rest of the file is not in the cache
+  /// (kResidencySamples of its pages say). Nothing where it is read through the cache: reads
+  /// that jump about (a VDB's grids), and a file found in the cache (a file read before, by
+  /// convert's spacing pass: from then on). The stream ends, its ring freed, at the end of the
+  /// file.
+  std::optional<std::size_t> readAround(std::uint64_t offset, void* data, std::size_t bytes) {
+    const std::lock_guard lock(mStreamMutex);
+    if (!mStream || mStream->position() != offset) {
+      mStream.reset();
+      mStreamPosition.store(kNoStream, std::memory_order_relaxed);
+      if (mFoundCached || bytes < kReadAheadTrigger ||
+          (offset != 0 && offset != mReadEnd.load(std::memory_order_relaxed)))
+        return std::nullopt;
+      mFoundCached = mResidency->sampledCached(offset, mSize - std::min(mSize, offset), kResidencySamples);
+      if (mFoundCached) return std::nullopt;
+      mStream = std::make_unique<DirectReadAhead>(mDirectFd, mFd, mPath, mSize, offset, mReadOnceAheadBytes);
+    }
+    const std::size_t n = mStream->read(data, bytes);
+    mReadEnd.store(offset + n, std::memory_order_relaxed);
+    const bool ended = n < bytes || mStream->position() >= mSize;
+    if (ended) mStream.reset();
+    mStreamPosition.store(ended ? kNoStream : mStream->position(), std::memory_order_relaxed);
+    return n;
+  }
+
   /// Deep read-ahead of a sequential reader: a large read (at least kReadAheadTrigger) that
   /// continues the last one asks the kernel (POSIX_FADV_WILLNEED) for the next kReadAheadBytes
   /// beyond it, in steps of a quarter of that. A reader that asks a cold disk for a few MB at a
@@ -77,12 +118,21 @@ class FileByteSource final : public ByteSource {
   }
 
   static constexpr std::size_t kReadAheadTrigger = std::size_t(1) << 20;
+  static constexpr unsigned kResidencySamples = 64;
+  static constexpr std::uint64_t kNoStream = ~std::uint64_t(0);
   static constexpr std::uint64_t kReadAheadBytes = std::uint64_t(64) << 20;
   std::filesystem::path mPath;
   int mFd = -1;
   std::uint64_t mSize = 0;
   std::atomic<std::uint64_t> mReadEnd{0};   ///< where the last read ended
   std::atomic<std::uint64_t> mAheadEnd{0};  ///< how far the read-ahead was asked for
+  std::size_t mReadOnceAheadBytes;          ///< 0: the file may be read again
+  int mDirectFd = -1;                       ///< opened with O_DIRECT: a file read once
+  std::optional<PageCacheResidency> mResidency;  ///< with mDirectFd
+  std::mutex mStreamMutex;
+  std::unique_ptr<DirectReadAhead> mStream;               ///< the large reads in order of a file read once
+  std::atomic<std::uint64_t> mStreamPosition{kNoStream};  ///< mStream's, for readAt without the lock
+  bool mFoundCached = false;                              ///< read through the cache from then on
 };
 
 class MemoryByteSource final : public ByteSource {
@@ -103,8 +153,8 @@ class MemoryByteSource final : public ByteSource {
 
 }  // namespace
 
-InputFile::InputFile(std::filesystem::path path)
-    : InputFile(path, std::make_unique<FileByteSource>(path)) {}
+InputFile::InputFile(std::filesystem::path path, std::size_t readOnceAheadBytes)
+    : InputFile(path, std::make_unique<FileByteSource>(path, readOnceAheadBytes)) {}
 
 InputFile::InputFile(std::filesystem::path name, std::span<const std::byte> bytes)
     : InputFile(std::move(name), std::make_unique<MemoryByteSource>(bytes)) {}

@@ -37,7 +37,10 @@ class ByteSource {
 class InputFile {
  public:
   /// Opens `path` for reading. Throws FileError when it is missing, a directory or unreadable.
-  explicit InputFile(std::filesystem::path path);
+  /// `readOnceAheadBytes`, where not 0: the file is read once, in order, and its large reads go
+  /// around the page cache where its pages are not in it, with that many bytes read ahead
+  /// (DirectReadAhead.h); else every read goes through the page cache.
+  explicit InputFile(std::filesystem::path path, std::size_t readOnceAheadBytes = 0);
   /// Reads `bytes` (which must outlive this object) as if they were the file `name`.
   InputFile(std::filesystem::path name, std::span<const std::byte> bytes);
   /// Reads what `source` presents, named `name` in messages (e.g. "shot.0001.bgeo.sc").

@@ -152,7 +152,7 @@ RecognisedInput recogniseInput(InputFile file) {
 }
 
 std::unique_ptr<ParticleSource> openParticleFile(const std::filesystem::path& path, const ReadOptions& options) {
-  RecognisedInput input = recogniseInput(InputFile(path));
+  RecognisedInput input = recogniseInput(InputFile(path, options.readOnceAheadBytes));
   return input.format->open(std::move(input.file), options);
 }
 

@@ -292,12 +292,13 @@ class PlyReader final : public ParticleSource {
 
   bool read(ParticleChunk& chunk, std::size_t maxParticles) override {
     FLIPSCOPE_CHECK(maxParticles > 0);
-    chunk.clear();
     syncColumns(chunk.attributes, mColumns);
     std::uint64_t n = std::min<std::uint64_t>(maxParticles, mHeader.vertexCount - mNext);
-    if (n == 0) return false;
-    chunk.positions.resize(n);
-    if (mHasVelocity) chunk.velocities.resize(n);
+    if (n == 0) {
+      chunk.clear();
+      return false;
+    }
+    chunk.resizeForOverwrite(n, mHasVelocity);
     for (auto& column : chunk.attributes) column.values.resize(n);
     if (mHeader.encoding == PlyEncoding::Ascii)
       readAscii(chunk, n);

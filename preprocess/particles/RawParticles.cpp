@@ -29,10 +29,13 @@ class RawReader final : public ParticleSource {
   std::optional<std::uint64_t> countHint() const override { return mCount; }
   bool read(ParticleChunk& chunk, std::size_t maxParticles) override {
     FLIPSCOPE_CHECK(maxParticles > 0);
-    chunk.clear();
     std::uint64_t n = std::min<std::uint64_t>(maxParticles, mCount - mNext);
-    if (n == 0) return false;
-    chunk.positions.resize(n);
+    if (n == 0) {
+      chunk.clear();
+      return false;
+    }
+    chunk.resizeForOverwrite(n, false);
+    chunk.attributes.clear();  // a chunk read into before may hold a column added after (TypedSource)
     std::size_t bytes = n * kRawParticleBytes;
     if (mFile.read(chunk.positions.data(), bytes) != bytes)
       throw FileError(mFile.path(), "file ends at byte " + std::to_string(mFile.offset()) + ", particle " +

@@ -1,5 +1,7 @@
 // Binning (convertFrame) against a brute-force oracle, and out-of-core against in-core.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -22,6 +24,7 @@
 #include "preprocess/Convert.h"
 #include "preprocess/ParticleSpacing.h"
 #include "preprocess/PositionRanges.h"
+#include "preprocess/particles/DirectReadAhead.h"
 #include "preprocess/particles/ParticleWriter.h"
 
 namespace flipscope {
@@ -267,6 +270,59 @@ INSTANTIATE_TEST_SUITE_P(
                       OutOfCoreCase{64, 0.1, true, "FewBricksSortedAsKeysAreMade", glm::vec3(1.0f), true},
                       OutOfCoreCase{32, 0.05, false, "LongThinGridInStripes", {4.0f, 0.08f, 0.08f}}),
     [](const auto& info) { return std::string(info.param.name); });
+
+// convert's binning pass reads its input once, around the page cache where it is not cached
+// (DirectReadAhead): the store is the bytes of one binned from memory, in core and out of core.
+// The particles of the PLY start past its header, at no whole block, and end at no whole piece.
+TEST(Convert, AFileReadAroundThePageCacheGivesTheSameStoreInCoreAndOutOfCore) {
+  const auto positions = testing::randomParticles(1000003, 78, 50.0f);
+  std::vector<glm::vec3> velocities(positions.size());
+  for (std::size_t i = 0; i < positions.size(); ++i) velocities[i] = glm::vec3(std::cos(float(i)), 0.25f, 1);
+  testing::TempDir temp("read-around");
+  const fs::path ply = temp / "frame.ply";
+  {
+    WriteOptions write;
+    write.velocity = true;
+    auto writer = createParticleWriter(ply, write);
+    ParticleChunk chunk;
+    chunk.positions = positions;
+    chunk.velocities = velocities;
+    writer->write(chunk);
+    writer->commit();
+  }
+  ConvertOptions options;
+  options.cellSize = 0.05;
+  options.progress = Progress::Mode::Silent;
+  const Box domain{{0, 0, 0}, {50, 50, 50}};
+  auto run = [&](ParticleSource& source, std::uint64_t budget, const std::string& name) {
+    options.memoryBudget = budget;
+    StoreHeader header = makeStoreHeader(domain, options, AttributeKind::Speed);
+    header.id = {7, 7, 7};
+    BrickStore store = BrickStore::createOrAppend(temp / name, header);
+    const FrameReport report = convertFrame(source, store, 1, options);
+    EXPECT_EQ(report.stats.particles, positions.size()) << name;
+    EXPECT_EQ(report.spillBuckets > 0, budget < (1ull << 30)) << name;
+    return readFile(temp / name / "frame_000001.fsf");
+  };
+  testing::VectorSource fromMemory(positions, velocities);
+  const auto expected = run(fromMemory, 1ull << 30, "memory");
+  for (const std::uint64_t budget : {1ull << 30, 4ull << 20}) {
+    const std::string name = budget < (1ull << 30) ? "out-of-core" : "in-core";
+    const bool dropped = testing::dropFromPageCache(ply);
+    ReadOptions read;
+    read.readOnceAheadBytes = 4 << 20;
+    auto source = openParticleFile(ply, read);
+    EXPECT_EQ(run(*source, budget, name), expected) << name;
+    // Read around the cache: the middle of the file stays out of it (not on tmpfs, whose pages
+    // are the file).
+    if (dropped) {
+      const int fd = ::open(ply.c_str(), O_RDONLY | O_CLOEXEC);
+      const PageCacheResidency residency(fd, fs::file_size(ply));
+      EXPECT_FALSE(residency.cached(fs::file_size(ply) / 2, 1 << 20)) << name;
+      ::close(fd);
+    }
+  }
+}
 
 // computeKeys keeps the runs of its sorted blocks only while they stay within one per
 // kKeysPerRun keys (plus one a brick), whatever the particles' order: particles in random order

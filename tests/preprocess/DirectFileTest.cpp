@@ -11,9 +11,7 @@
 namespace flipscope {
 namespace {
 
-using detail::AlignedBuffer;
 using detail::DirectFile;
-using detail::kDirectBlock;
 
 TEST(DirectFile, BlocksReadBackInOrderAndTheEndIsAShortRead) {
   testing::TempDir dir("direct-file");

@@ -162,6 +162,30 @@ TEST(RawReader, NaNPassesThrough) {
   EXPECT_TRUE(sameParticles(readFile(dir / "n.raw", 8), particles));
 }
 
+// A chunk read into again holds what the reader gives and nothing of before: a column a wrapper
+// added (convert's TypedSource appends the particles' types) or velocities; positions that grow
+// over the last read's are still the file's.
+TEST(RawReader, AChunkReadIntoAgainHoldsOnlyItsPositions) {
+  TempDir dir("raw-again");
+  auto particles = randomParticles(50, false, 4);
+  writeFile(dir / "a.raw", particles, WriteOptions{});
+  auto source = openParticleFile(dir / "a.raw");
+  ParticleChunk chunk;
+  std::size_t at = 0;
+  for (std::size_t size : {8, 8, 20, 30}) {
+    chunk.attributes.push_back({"types", 1, std::vector<float>(chunk.size(), 0.0f)});
+    chunk.velocities.assign(chunk.size(), glm::vec3(1));
+    ASSERT_TRUE(source->read(chunk, size));
+    const std::size_t expected = std::min<std::size_t>(size, 50 - at);
+    ASSERT_EQ(chunk.size(), expected);
+    EXPECT_TRUE(chunk.attributes.empty());
+    EXPECT_TRUE(chunk.velocities.empty());
+    for (std::size_t i = 0; i < expected; ++i) ASSERT_EQ(chunk.positions[i], particles.positions[at + i]) << at + i;
+    at += expected;
+  }
+  EXPECT_FALSE(source->read(chunk, 8));
+}
+
 // ---- Malformed files ----
 
 TEST(RawReader, SizeNotMultipleOf12) {
