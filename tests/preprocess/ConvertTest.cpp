@@ -15,6 +15,7 @@
 
 #include "GzipTestWriter.h"
 #include "ParticleTestSupport.h"
+#include "StoreComparison.h"
 #include "TestSupport.h"
 #include "VectorSource.h"
 #include "core/AtomicFile.h"
@@ -322,6 +323,38 @@ TEST(Convert, AFileReadAroundThePageCacheGivesTheSameStoreInCoreAndOutOfCore) {
       ::close(fd);
     }
   }
+}
+
+// convert keeps the storage of a frame's keys for the next frame (its pages touched once): frames
+// of a sequence that shrinks and grows, their keys sorted as they are made (particles in order
+// along x: runs kept) or not (random order), convert into the frames of converts one frame each.
+TEST(Convert, FramesBinnedInTheKeysOfTheFrameBeforeAreTheFramesConvertedAlone) {
+  testing::TempDir temp("reused-keys");
+  const std::size_t counts[] = {300000, 100000, 200000};
+  std::vector<FrameInput> inputs;
+  for (int f = 0; f < 3; ++f) {
+    auto positions = testing::randomParticles(counts[f], 90 + f, 50.0f);
+    if (f != 1) std::sort(positions.begin(), positions.end(), [](const auto& a, const auto& b) { return a.x < b.x; });
+    ParticleChunk chunk;
+    chunk.positions = positions;
+    chunk.velocities.resize(positions.size());
+    for (std::size_t i = 0; i < positions.size(); ++i) chunk.velocities[i] = glm::vec3(std::sin(float(i + f)), 1, 0);
+    const fs::path file = temp / ("frame_" + std::to_string(f) + ".ply");
+    WriteOptions write;
+    write.velocity = true;
+    auto writer = createParticleWriter(file, write);
+    writer->write(chunk);
+    writer->commit();
+    inputs.push_back({f, {file}});
+  }
+  ConvertOptions options;
+  options.cellSize = 0.1;  // 8^3 bricks of 64: computeKeys sorts
+  options.particleSpacing = 0.05;
+  options.domain = Box{{0, 0, 0}, {50, 50, 50}};
+  options.progress = Progress::Mode::Silent;
+  convert(inputs, temp / "sequence", options);
+  for (const FrameInput& input : inputs) convert({input}, temp / "one-by-one", options);  // appended
+  testing::expectSameFrames(temp / "sequence", temp / "one-by-one");
 }
 
 // computeKeys keeps the runs of its sorted blocks only while they stay within one per
