@@ -11,8 +11,9 @@
 // - Direct reads of 1 to 2 MiB ran the disk fastest (dd: 0.76 to 0.82 s; 4 MiB 0.83 to 0.98 s,
 //   16 MiB 1.06 to 1.32 s).
 // - One reading thread left the disk idle between its reads while it waited for a core (both
-//   binning); two keep a read in flight (given a ring of three pieces or more: --mem 96M up). The frame converted in one read (spacing and domain
-//   given) in 1.39 to 1.52 s, against 1.60 to 1.73 s through the page cache, alternating runs.
+//   binning); two keep a read in flight (given a ring of three pieces or more: --mem 96M up).
+// - The frame converted in one read (spacing and domain given) in 1.33 to 1.49 s, against 1.52
+//   to 1.55 s through the page cache, alternating runs; 16 KB of it left in the cache, not 1.2 GB.
 // The ring's copy costs what the page cache's copy did. Pages that are cached are read from the
 // disk too: reading them through the cache would start the kernel's read-ahead from the marks
 // it left in them (its windows were 8 to 16 MiB here), which then keeps ahead of the stream and
