@@ -211,19 +211,15 @@ void runBenchPreprocess(const BenchPreprocessArgs& a) {
         (std::string(read->direct ? "disk read (O_DIRECT, " : "disk read (pages dropped, ") + label + ")").c_str(),
         read->seconds, Progress::humanCount(particles / read->seconds).c_str(), "",
         read == &disk ? "   the disk read" : "");
-  const std::string inCoreLabel = std::string("convert from disk, ") + (coldInCoreSpilled ? "out of core" : "in core");
-  std::printf("%-34s %10.3f %16s %12s   %.2fx the disk read\n", inCoreLabel.c_str(), coldInCore,
-              Progress::humanCount(particles / coldInCore).c_str(), "", coldInCore / disk.seconds);
-  const std::string outLabel = "convert from disk, --mem " + a.outOfCoreMem + (coldSpilled ? "" : " (fit)");
-  std::printf("%-34s %10.3f %16s %12s   %.2fx the disk read\n", outLabel.c_str(), coldOutOfCore,
-              Progress::humanCount(particles / coldOutOfCore).c_str(), "", coldOutOfCore / disk.seconds);
-  const std::string oneReadLabel =
-      std::string("  one read (spacing, domain given)") + (coldOneReadSpilled ? ", out of core" : "");
-  std::printf("%-34s %10.3f %16s %12s   %.2fx the disk read\n", oneReadLabel.c_str(), coldOneRead,
-              Progress::humanCount(particles / coldOneRead).c_str(), "", coldOneRead / disk.seconds);
-  const std::string oneReadOutLabel = "  one read, --mem " + a.outOfCoreMem + (coldOneReadOutSpilled ? "" : " (fit)");
-  std::printf("%-34s %10.3f %16s %12s   %.2fx the disk read\n", oneReadOutLabel.c_str(), coldOneReadOutOfCore,
-              Progress::humanCount(particles / coldOneReadOutOfCore).c_str(), "", coldOneReadOutOfCore / disk.seconds);
+  const auto fromDiskRow = [&](const std::string& label, double seconds) {
+    std::printf("%-34s %10.3f %16s %12s   %.2fx the disk read\n", label.c_str(), seconds,
+                Progress::humanCount(particles / seconds).c_str(), "", seconds / disk.seconds);
+  };
+  fromDiskRow(std::string("convert from disk, ") + (coldInCoreSpilled ? "out of core" : "in core"), coldInCore);
+  fromDiskRow("convert from disk, --mem " + a.outOfCoreMem + (coldSpilled ? "" : " (fit)"), coldOutOfCore);
+  fromDiskRow(std::string("  one read (spacing, domain given)") + (coldOneReadSpilled ? ", out of core" : ""),
+              coldOneRead);
+  fromDiskRow("  one read, --mem " + a.outOfCoreMem + (coldOneReadOutSpilled ? "" : " (fit)"), coldOneReadOutOfCore);
   std::printf("\ntarget: convert <= 4x raw read (goal 1.5x): %s\n", ratio <= 4 ? "met" : "NOT met");
   const auto met = [&](double seconds) { return seconds <= 1.25 * disk.seconds ? "met" : "NOT met"; };
   std::printf(
