@@ -1,6 +1,7 @@
 #include "raycast/Camera.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <span>
@@ -26,6 +27,25 @@ glm::dvec3 Camera::pixelRay(double x, double y, std::uint32_t width, std::uint32
   const double sx = ((x + 0.5) / width * 2 - 1) * tanHalf * double(width) / double(height);
   const double sy = (1 - (y + 0.5) / height * 2) * tanHalf;
   return glm::normalize(forward() + sx * right() + sy * trueUp());
+}
+
+bool boxMayBeInView(const Camera& camera, std::uint32_t width, std::uint32_t height, const Box& box) {
+  if (box.isEmpty()) return false;
+  const double tanY = std::tan(glm::radians(camera.fovYDegrees) * 0.5);
+  const double tanX = tanY * double(width) / double(height);
+  const glm::dvec3 f = camera.forward(), r = camera.right(), u = camera.trueUp();
+  // The inward normals of the four side planes through the eye and the image's edges: the
+  // pyramid they bound holds every pixel's ray (the centre rays lie within the edges) and
+  // nothing behind the eye.
+  const std::array<glm::dvec3, 4> inward = {tanX * f - r, tanX * f + r, tanY * f - u, tanY * f + u};
+  for (const glm::dvec3& n : inward) {
+    // The box's corner farthest along n (its "positive vertex"): the box lies wholly outside
+    // the plane when that corner does.
+    const glm::dvec3 corner(n.x >= 0 ? box.max.x : box.min.x, n.y >= 0 ? box.max.y : box.min.y,
+                            n.z >= 0 ? box.max.z : box.min.z);
+    if (glm::dot(n, corner - camera.eye) < 0) return false;
+  }
+  return true;
 }
 
 void validate(const Camera& camera, const std::string& what) {

@@ -30,6 +30,11 @@ struct Camera {
   bool operator==(const Camera&) const = default;
 };
 
+/// Whether `box` may hold a point that a ray of a width x height image (pixelRay) passes
+/// through: it meets the pyramid of the image's corner rays, or lies near one of its edges (the
+/// test is conservative: each side plane alone). Boxes behind the eye are out.
+bool boxMayBeInView(const Camera& camera, std::uint32_t width, std::uint32_t height, const Box& box);
+
 /// Throws InputError naming `what` when eye == target, up is parallel to the view direction, or
 /// the field of view is outside (0, 180).
 void validate(const Camera& camera, const std::string& what);

@@ -216,9 +216,34 @@ struct FrameRenderer::ActiveFrame {
 RenderStats FrameRenderer::trace(int frame, const Camera& camera, int direction) {
   const auto start = Clock::now();
   begin(frame, camera, direction);
+  if (mSettings.prefetchView) prefetchView(camera);
   runPasses(true, std::numeric_limits<double>::infinity(), nullptr);
   mActive->stats.totalMs = msSince(start);
   return mActive->stats;
+}
+
+void FrameRenderer::prefetchView(const Camera& camera) {
+  ActiveFrame& a = *mActive;
+  const StoreHeader& header = mSource->header();
+  const double brickWorld = header.cellSize * header.brickSize;
+  const double margin = header.cellSize * mOverlap;  // a ray meets a brick's border cells too
+  std::vector<glm::uvec3> coords;
+  std::size_t frameResident = 0;
+  for (std::size_t i = 0; i < a.pages.size(); ++i) {
+    if (a.pages[i] != kNotResident) {
+      ++frameResident;
+      continue;
+    }
+    const glm::dvec3 lo = header.origin + glm::dvec3(a.index->bricks[i].coord) * brickWorld;
+    if (boxMayBeInView(camera, mSettings.width, mSettings.height, Box{lo - margin, lo + brickWorld + margin}))
+      coords.push_back(a.index->bricks[i].coord);
+  }
+  // Where the pool cannot hold them with the frame's resident bricks, the passes stream what
+  // the rays meet, as they come.
+  if (coords.empty() || frameResident + coords.size() > mPool.layout().slots) return;
+  a.stats.bricksRequested += coords.size();
+  mStreamer->request(coords);
+  streamAndUpload(coords);
 }
 
 bool FrameRenderer::growPool(std::uint64_t wanted) {
@@ -298,23 +323,7 @@ void FrameRenderer::runPasses(bool wait, double budgetMs, bool* changed) {
       }
       mStreamer->request(coords);
       if (wait) {
-        // Convert (or fetch from the CPU cache) every requested brick before the next pass.
-        const auto streamStart = Clock::now();
-        std::unordered_map<BrickKey, bool, BrickKeyHash> wanted;
-        for (glm::uvec3 coord : coords) wanted.emplace(BrickKey{a.frame, coord}, false);
-        std::vector<std::shared_ptr<const ConvertedBrick>> bricks;
-        while (bricks.size() < wanted.size()) {
-          mStreamer->waitIdle();
-          auto ready = mStreamer->takeReady(wanted.size());
-          if (mStreamer->stats().failed > a.failedBefore) mStreamer->rethrowLastError();
-          if (ready.empty())
-            throw LogicError("the streamer delivered " + std::to_string(bricks.size()) + " of " +
-                             std::to_string(wanted.size()) + " requested bricks");
-          for (auto& brick : ready)
-            if (wanted.contains(brick->key)) bricks.push_back(std::move(brick));
-        }
-        stats.streamMs += msSince(streamStart);
-        upload(std::move(bricks));
+        streamAndUpload(coords);
         a.traceDue = true;
         continue;
       }
@@ -342,6 +351,27 @@ void FrameRenderer::runPasses(bool wait, double budgetMs, bool* changed) {
     if (!a.traceDue || msSince(start) >= budgetMs) break;
   }
   stats.bricksResident = mPool.resident();
+}
+
+void FrameRenderer::streamAndUpload(const std::vector<glm::uvec3>& coords) {
+  ActiveFrame& a = *mActive;
+  // Convert (or fetch from the CPU cache) every requested brick before the next pass.
+  const auto streamStart = Clock::now();
+  std::unordered_map<BrickKey, bool, BrickKeyHash> wanted;
+  for (glm::uvec3 coord : coords) wanted.emplace(BrickKey{a.frame, coord}, false);
+  std::vector<std::shared_ptr<const ConvertedBrick>> bricks;
+  while (bricks.size() < wanted.size()) {
+    mStreamer->waitIdle();
+    auto ready = mStreamer->takeReady(wanted.size());
+    if (mStreamer->stats().failed > a.failedBefore) mStreamer->rethrowLastError();
+    if (ready.empty())
+      throw LogicError("the streamer delivered " + std::to_string(bricks.size()) + " of " +
+                       std::to_string(wanted.size()) + " requested bricks");
+    for (auto& brick : ready)
+      if (wanted.contains(brick->key)) bricks.push_back(std::move(brick));
+  }
+  a.stats.streamMs += msSince(streamStart);
+  upload(std::move(bricks));
 }
 
 void FrameRenderer::upload(std::vector<std::shared_ptr<const ConvertedBrick>> bricks) {

@@ -1,7 +1,8 @@
 // FrameRenderer: the request-driven frame loop (Reichl et al. 2014 §3.3, §4.4). Each pass traces
 // the pending rays; the bricks they stopped at are converted by the Streamer (or found in its
 // CPU cache), placed in the BrickPool and uploaded, and the next pass resumes the rays, until no
-// ray asks for anything. A cold frame converges in a few passes, a warm one in one. Bricks,
+// ray asks for anything. A cold frame converges in a few passes, a warm one in one; trace()
+// first streams a cold frame's bricks in view where the pool holds them (prefetchView). Bricks,
 // frame indices and the domain come from a BrickSource (streaming/BrickSource.h): a store, or a
 // synthetic source in tests.
 //
@@ -48,6 +49,14 @@ struct RenderSettings {
   /// (resolve() decides). FramePipeline's store gives bricks without it then
   /// (StoreBrickSource); the renderer follows what its source carries.
   bool attributes = true;
+  /// Whether trace() streams the bricks of a frame that lie in view (boxMayBeInView) before its
+  /// first pass, where the pool holds them with those of the frame already resident: that pass
+  /// would only find them, one pass for the bricks in front and more for those behind
+  /// (§3.3's loop, which still resolves whatever the rays meet that is not resident). A cold
+  /// frame then takes one pass where every brick in view is met (20 M particles, 1280x720:
+  /// 30 bricks, three passes of 120 ms on 2 cores became one of 95 ms). Bricks in view that
+  /// no ray reaches (behind an opaque front) are streamed needlessly.
+  bool prefetchView = true;
 };
 /// Throws InputError naming the setting that is out of range.
 void validate(const RenderSettings& settings);
@@ -150,6 +159,11 @@ class FrameRenderer {
   /// Places and uploads `bricks` of the active frame nearest to the eye first, then classifies
   /// their foam.
   void upload(std::vector<std::shared_ptr<const ConvertedBrick>> bricks);
+  /// Waits until the Streamer has converted (or found in its CPU cache) every brick of the
+  /// active frame at `coords`, requested before, then uploads them.
+  void streamAndUpload(const std::vector<glm::uvec3>& coords);
+  /// RenderSettings::prefetchView for the frame begun.
+  void prefetchView(const Camera& camera);
 
   std::shared_ptr<BrickSource> mSource;
   std::unique_ptr<RaycastDevice> mDevice;

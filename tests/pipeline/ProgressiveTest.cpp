@@ -31,7 +31,7 @@ TEST(ProgressiveFrames, AdvancedToTheEndEqualsRender) {
   FramePipeline reference = cpuPipeline(source);
   const FrameOutput expected = reference.render(1, GatedBrickSource::camera());
   ASSERT_TRUE(expected.stats.converged);
-  ASSERT_GT(expected.stats.passes, 1) << "a cold frame needs bricks streamed in";
+  ASSERT_GT(expected.stats.bricksUploaded, 0u) << "a cold frame needs bricks streamed in";
 
   FramePipeline progressive = cpuPipeline(source);
   progressive.begin(1, GatedBrickSource::camera());

@@ -147,7 +147,9 @@ TEST(CpuRaycaster, HitsCarryTheirCellsAttribute) {
 TEST(FrameRenderer, ColdFrameConvergesToTheWarmImageInOnePass) {
   TempDir dir("warm");
   BrickStore store = testing::makeStore(dir / "store", {testing::randomParticles(8000, 7, 64.0f)}, 64.0f, 32);
-  auto renderer = cpuRenderer(store, testing::smallSettings());
+  RenderSettings loop = testing::smallSettings();
+  loop.prefetchView = false;  // the request loop alone streams the cold frame
+  auto renderer = cpuRenderer(store, loop);
   const Camera camera = frameOnBox(renderer->occupiedBounds(0), 128.0 / 72.0);
   const RenderResult cold = renderer->render(0, camera);
   const RenderResult warm = renderer->render(0, camera);
@@ -158,6 +160,40 @@ TEST(FrameRenderer, ColdFrameConvergesToTheWarmImageInOnePass) {
   ASSERT_EQ(cold.hits.size(), warm.hits.size());
   EXPECT_EQ(0, std::memcmp(cold.hits.data(), warm.hits.data(), cold.hits.size() * sizeof(RayHit)))
       << firstDifference(cold.hits, warm.hits);
+}
+
+TEST(FrameRenderer, BricksInViewStreamedBeforeTheFirstPassGiveTheRequestLoopsImageInOnePass) {
+  TempDir dir("prefetch");
+  BrickStore store = testing::makeStore(dir / "store", {testing::randomParticles(20000, 4, 96.0f)}, 96.0f, 32);
+  RenderSettings loopSettings = testing::smallSettings();
+  loopSettings.prefetchView = false;
+  auto ahead = cpuRenderer(store, testing::smallSettings());
+  const Box bounds = ahead->occupiedBounds(0);
+  const Camera whole = frameOnBox(bounds, 128.0 / 72.0);
+  // Outside one face, looking along a row of bricks near an edge: most bricks lie out of view.
+  Camera row = whole;
+  row.eye = bounds.min + bounds.extent() * glm::dvec3(-0.1, 1.0 / 6, 1.0 / 6);
+  row.target = row.eye + glm::dvec3(1, 0, 0);
+  row.up = {0, 1, 0};
+  row.fovYDegrees = 15;
+  std::uint64_t uploaded[2] = {0, 0};
+  const Camera cameras[2] = {whole, row};
+  for (int c = 0; c < 2; ++c) {
+    auto loop = cpuRenderer(store, loopSettings);
+    auto prefetching = cpuRenderer(store, testing::smallSettings());
+    const RenderResult expected = loop->render(0, cameras[c]);
+    const RenderResult result = prefetching->render(0, cameras[c]);
+    ASSERT_TRUE(result.stats.converged);
+    EXPECT_GT(expected.stats.passes, 1);
+    EXPECT_EQ(result.stats.passes, 1);
+    EXPECT_EQ(result.stats.bricksUploaded, result.stats.bricksRequested);
+    EXPECT_GE(result.stats.bricksUploaded, expected.stats.bricksUploaded) << "every brick a ray met was in view";
+    EXPECT_EQ(0, std::memcmp(expected.hits.data(), result.hits.data(), result.hits.size() * sizeof(RayHit)))
+        << firstDifference(expected.hits, result.hits);
+    uploaded[c] = result.stats.bricksUploaded;
+  }
+  EXPECT_EQ(uploaded[0], 27u) << "the whole frame is in view";
+  EXPECT_LT(uploaded[1], uploaded[0] / 2) << "bricks out of view are not streamed";
 }
 
 TEST(FrameRenderer, TinyPoolConvergesByEvictionToTheSameImage) {
@@ -175,7 +211,8 @@ TEST(FrameRenderer, TinyPoolConvergesByEvictionToTheSameImage) {
   EXPECT_EQ(starved->settings().gpuBudgetBytes, tiny.gpuBudgetBytes);
   EXPECT_GT(result.stats.bricksEvicted, 0u);
   EXPECT_LE(result.stats.bricksResident, 3u);
-  EXPECT_GT(result.stats.passes, expected.stats.passes);
+  EXPECT_EQ(expected.stats.passes, 1) << "the frame's bricks in view were streamed before the pass";
+  EXPECT_GT(result.stats.passes, expected.stats.passes) << "the pool cannot hold them: the request loop streams them";
   // A pool too small for the frame makes thickness best effort; the hits stay exact.
   std::vector<RayHit> withoutThickness = result.hits, expectedWithout = expected.hits;
   int thinner = 0;
@@ -239,7 +276,7 @@ TEST(FrameRenderer, ConvergesOverASyntheticSource) {
   for (int frame : {0, 1}) {
     const RenderResult cold = renderer.render(frame, camera);
     ASSERT_TRUE(cold.stats.converged) << "frame " << frame;
-    EXPECT_GT(cold.stats.passes, 1);
+    EXPECT_EQ(cold.stats.passes, 1) << "its bricks in view are streamed before the pass (prefetchView)";
     EXPECT_GT(cold.stats.bricksUploaded, 0u);
     EXPECT_EQ(cold.stats.frameBricks, source->frame(frame)->bricks.size());
     std::size_t hits = 0;
