@@ -357,9 +357,12 @@ TEST_F(Cli, ExitCodesAndMessagesForEveryKindOfFailure) {
             "no/such/dir/x.png");
   // Sizes beyond 32 bits are refused, not wrapped.
   expectRun("render " + path("store") + " -o " + path("x.png") + " --size 4294967360x4294967332", 2, "--size");
-  // A render stopped by its pass limit writes its image and says so with exit 5.
-  expectRun("render " + path("store") + " -o " + path("limit.png") + " --size 64x36 --device cpu --max-passes 1", 5,
-            "--max-passes");
+  // A render stopped by its pass limit writes its image and says so with exit 5: a frame of 33
+  // bricks, more in view than a pool of 1 MB holds, so that its first pass cannot have them all.
+  ASSERT_EQ(runFlipscope("convert " + path("f.ply") + " -o " + path("bricks") + " --resolution 256 -q").exitCode, 0);
+  expectRun("render " + path("bricks") + " -o " + path("limit.png") +
+                " --size 64x36 --device cpu --max-passes 1 --gpu-mem 1M",
+            5, "--max-passes");
   EXPECT_TRUE(fs::exists(dir / "limit.png"));
   // Data far from the origin renders when doubles can frame it, and otherwise says why plainly.
   auto writeRaw = [&](const std::string& name, float step) {
