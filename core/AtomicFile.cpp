@@ -205,6 +205,13 @@ void AtomicFile::write(const void* data, std::size_t bytes) {
   FLIPSCOPE_CHECK(mFile, "write after commit");
   if (bytes && std::fwrite(data, 1, bytes, mFile) != bytes) throw temporaryFailure("write");
   mOffset += bytes;
+  if (mOffset - mWritebackStarted >= kAtomicFileWritebackBytes) {
+    if (std::fflush(mFile) != 0) throw temporaryFailure("flush");
+    // Only a hint: where it fails (a file system without it), commit()'s fsync writes all.
+    ::sync_file_range(::fileno(mFile), off64_t(mWritebackStarted), off64_t(mOffset - mWritebackStarted),
+                      SYNC_FILE_RANGE_WRITE);
+    mWritebackStarted = mOffset;
+  }
 }
 
 void AtomicFile::writeAt(std::uint64_t offset, const void* data, std::size_t bytes) {

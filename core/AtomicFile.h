@@ -88,6 +88,10 @@ bool processExists(long pid);
 
 /// The bytes an AtomicFile gathers before it writes them.
 inline constexpr std::size_t kAtomicFileBufferBytes = std::size_t(1) << 20;
+/// An AtomicFile asks the kernel to start writing its bytes back each time this many more were
+/// written (sync_file_range, without waiting), so that commit()'s fsync waits for the last few
+/// only: a frame of a store is fsynced as the next bricks are encoded, not after them all.
+inline constexpr std::uint64_t kAtomicFileWritebackBytes = std::uint64_t(2) << 20;
 
 class AtomicFile {
  public:
@@ -117,6 +121,7 @@ class AtomicFile {
   StdioBuffer mBuffer{kAtomicFileBufferBytes};  ///< mFile's
   std::FILE* mFile = nullptr;
   std::uint64_t mOffset = 0;
+  std::uint64_t mWritebackStarted = 0;  ///< bytes [0, this) were handed to sync_file_range
 
   /// The error of a failed `what` ("write", "flush"; `atByte`: where a write went) on the
   /// temporary, with the reason of the errno the failing call left (call it at once: it reads

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -359,6 +360,31 @@ TEST(AtomicFile, SmallWritesAreGatheredInItsBufferUntilCommit) {
   EXPECT_EQ(fs::file_size(file.temporaryPath()), 0u);  // nothing written yet: one write at commit
   file.commit();
   EXPECT_EQ(fs::file_size(temp / "out.bin"), pieces * piece.size());
+}
+
+TEST(AtomicFile, ItsBytesGoToTheKernelEachWritebackStepAndAFieldWrittenBackBeforeIsRewritten) {
+  testing::TempDir temp("atomicwriteback");
+  std::vector<std::byte> expected;
+  {
+    AtomicFile file(temp / "out.bin");
+    std::vector<std::byte> piece(1000003);
+    for (int p = 0; p < 7; ++p) {
+      for (std::size_t i = 0; i < piece.size(); ++i) piece[i] = std::byte((i * 7 + std::size_t(p) * 13) & 0xff);
+      file.write(piece.data(), piece.size());
+      expected.insert(expected.end(), piece.begin(), piece.end());
+      if (p == 2) {
+        // The first step was crossed by this write: everything so far is flushed, for its writeback.
+        ASSERT_GE(file.offset(), kAtomicFileWritebackBytes);
+        EXPECT_EQ(fs::file_size(file.temporaryPath()), file.offset());
+      }
+    }
+    ASSERT_GT(file.offset(), 3 * kAtomicFileWritebackBytes);
+    const std::uint32_t field = 0xfeedf00d;  // a header field, written back long ago
+    file.writeAt(16, &field, sizeof field);
+    std::memcpy(expected.data() + 16, &field, sizeof field);
+    file.commit();
+  }
+  EXPECT_EQ(readFile(temp / "out.bin"), expected);
 }
 
 TEST(StaleFiles, OnlyFilesOfProcessesThatAreGoneAreRemoved) {
