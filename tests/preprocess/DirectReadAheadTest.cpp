@@ -104,10 +104,12 @@ TEST(DirectReadAhead, PagesInTheCacheReadTheSameAroundIt) {
   data.resize(size + 10);
   ASSERT_EQ(stream.read(data.data(), data.size()), size);
   EXPECT_EQ(firstWrongByte(data, 0, size), -1);
-  EXPECT_TRUE(file.residency.cached(2 * kMiB, 3 * kMiB));
   if (dropped) {
     EXPECT_FALSE(file.residency.cached(6 * kMiB, 2 * kMiB));
     // Sampled: one page out of the cache is found where it is a sample, a first or last page.
+    // (Read into the cache again: a VM that hands free memory back to its host may have taken
+    // the pages since; a CI run saw it, with 73 MB left cached of 24 GB.)
+    ASSERT_EQ(::pread(file.cached, data.data(), 3 * kMiB, off_t(2 * kMiB)), ssize_t(3 * kMiB));
     EXPECT_TRUE(file.residency.sampledCached(2 * kMiB, 3 * kMiB, 16));
     EXPECT_FALSE(file.residency.sampledCached(2 * kMiB, 3 * kMiB + 4096, 16));
     EXPECT_FALSE(file.residency.sampledCached(2 * kMiB - 4096, 3 * kMiB, 16));
