@@ -13,6 +13,7 @@
 #include "core/Elapsed.h"
 #include "core/Error.h"
 #include "core/NumberText.h"
+#include "raycast/FirstBricks.h"
 #include "streaming/BrickMipmap.h"
 
 namespace flipscope {
@@ -216,28 +217,37 @@ struct FrameRenderer::ActiveFrame {
 RenderStats FrameRenderer::trace(int frame, const Camera& camera, int direction) {
   const auto start = Clock::now();
   begin(frame, camera, direction);
-  if (mSettings.prefetchView) prefetchView(camera);
+  if (mSettings.prefetch) prefetch(camera);
   runPasses(true, std::numeric_limits<double>::infinity(), nullptr);
   mActive->stats.totalMs = msSince(start);
   return mActive->stats;
 }
 
-void FrameRenderer::prefetchView(const Camera& camera) {
+void FrameRenderer::prefetch(const Camera& camera) {
   ActiveFrame& a = *mActive;
+  std::size_t frameResident = 0;
+  for (std::uint32_t page : a.pages) frameResident += page != kNotResident;
+  // The first pass's bricks: the first along each ray.
+  std::vector<glm::uvec3> first;
+  const std::uint32_t stride = firstBrickStride(mSettings.width, mSettings.height);
+  for (std::uint32_t i :
+       firstBricksAlongRays(camera, mSettings.width, mSettings.height, stride, mSource->header(), a.index->octree))
+    if (a.pages[i] == kNotResident) first.push_back(a.index->bricks[i].coord);
+  // Those in view: boxes widened by the border a ray meets too.
   const StoreHeader& header = mSource->header();
   const double brickWorld = header.cellSize * header.brickSize;
-  const double margin = header.cellSize * mOverlap;  // a ray meets a brick's border cells too
-  std::vector<glm::uvec3> coords;
-  std::size_t frameResident = 0;
+  const double margin = header.cellSize * mOverlap;
+  std::vector<glm::uvec3> view;
   for (std::size_t i = 0; i < a.pages.size(); ++i) {
-    if (a.pages[i] != kNotResident) {
-      ++frameResident;
-      continue;
-    }
     const glm::dvec3 lo = header.origin + glm::dvec3(a.index->bricks[i].coord) * brickWorld;
-    if (boxMayBeInView(camera, mSettings.width, mSettings.height, Box{lo - margin, lo + brickWorld + margin}))
-      coords.push_back(a.index->bricks[i].coord);
+    if (a.pages[i] == kNotResident &&
+        boxMayBeInView(camera, mSettings.width, mSettings.height, Box{lo - margin, lo + brickWorld + margin}))
+      view.push_back(a.index->bricks[i].coord);
   }
+  // The whole view where it is at most twice the first pass's bricks: the passes after would
+  // mostly find the rest behind them (a small frame's rays reach most of it), one pass each.
+  // Beyond, the bricks that no ray reaches behind an opaque front would cost more than that.
+  const std::vector<glm::uvec3>& coords = view.size() <= 2 * first.size() ? view : first;
   // Where the pool cannot hold them with the frame's resident bricks, the passes stream what
   // the rays meet, as they come.
   if (coords.empty() || frameResident + coords.size() > mPool.layout().slots) return;

@@ -88,7 +88,7 @@ TEST_P(GpuRaycasterScenes, EqualsTheCpuReference) {
   for (std::size_t i = 0; i < particles.size(); ++i) velocities.push_back({speed(rng), speed(rng), speed(rng)});
   BrickStore store = testing::makeStore(dir / "store", {particles}, extent, seed % 2 ? 32 : 64, {velocities});
   RenderSettings settings = testing::smallSettings();
-  settings.prefetchView = false;  // both devices take the same passes of the request loop
+  settings.prefetch = false;  // both devices take the request loop's passes, one by one
   settings.radius = seed % 2 ? 1.5f : 0.8f;
   settings.jitter = seed % 3 ? 0.4f : 0.0f;
   GPU_RENDERER(gpu, store, settings);
@@ -109,7 +109,7 @@ TEST(GpuRaycaster, ColdConvergesToWarmAndATinyPoolByEviction) {
   TempDir dir("gl-loop");
   BrickStore store = testing::makeStore(dir / "store", {testing::randomParticles(20000, 9, 96.0f)}, 96.0f, 32);
   RenderSettings settings = testing::smallSettings();
-  settings.prefetchView = false;  // the request loop alone streams the cold frame
+  settings.prefetch = false;  // the request loop alone streams the cold frame
   GPU_RENDERER(renderer, store, settings);
   const Camera camera = frameOnBox(renderer->occupiedBounds(0), 128.0 / 72.0);
   const RenderResult cold = renderer->render(0, camera);
