@@ -34,10 +34,10 @@ bool boxMayBeInView(const Camera& camera, std::uint32_t width, std::uint32_t hei
   const double tanY = std::tan(glm::radians(camera.fovYDegrees) * 0.5);
   const double tanX = tanY * double(width) / double(height);
   const glm::dvec3 f = camera.forward(), r = camera.right(), u = camera.trueUp();
-  // The inward normals of the four side planes through the eye and the image's edges: the
-  // pyramid they bound holds every pixel's ray (the centre rays lie within the edges) and
-  // nothing behind the eye.
-  const std::array<glm::dvec3, 4> inward = {tanX * f - r, tanX * f + r, tanY * f - u, tanY * f + u};
+  // The inward normals of the four side planes through the eye and the image's edges, which
+  // bound a pyramid holding every pixel's ray (the centre rays lie within the edges), and of
+  // the plane through the eye across the view: nothing behind the eye.
+  const std::array<glm::dvec3, 5> inward = {tanX * f - r, tanX * f + r, tanY * f - u, tanY * f + u, f};
   for (const glm::dvec3& n : inward) {
     // The box's corner farthest along n (its "positive vertex"): the box lies wholly outside
     // the plane when that corner does.

@@ -32,7 +32,8 @@ struct Camera {
 
 /// Whether `box` may hold a point that a ray of a width x height image (pixelRay) passes
 /// through: it meets the pyramid of the image's corner rays, or lies near one of its edges (the
-/// test is conservative: each side plane alone). Boxes behind the eye are out.
+/// test is conservative: each side plane alone, and the plane across the view at the eye, so
+/// that a box wholly behind the eye is out).
 bool boxMayBeInView(const Camera& camera, std::uint32_t width, std::uint32_t height, const Box& box);
 
 /// Throws InputError naming `what` when eye == target, up is parallel to the view direction, or

@@ -20,8 +20,8 @@ inline constexpr std::uint32_t kFirstBrickRays = 16384;
 std::uint32_t firstBrickStride(std::uint32_t width, std::uint32_t height);
 
 /// The distinct bricks (indices into the frame's brick table, ascending) that the rays through
-/// the centres of every `stride`-th pixel each way (pixelRay, from the middle of each stride x
-/// stride block) enter first among the bricks `octree` holds. A ray is walked in double
+/// the centres of pixels (stride i + stride / 2, stride j + stride / 2) (pixelRay; the last row
+/// and column at most) enter first among the bricks `octree` holds. A ray is walked in double
 /// precision from cell to cell of the brick grid (Amanatides and Woo), where the ray-caster
 /// walks in floats, so a ray that grazes a brick's edge may find another: a hint, not the
 /// first pass's exact requests.

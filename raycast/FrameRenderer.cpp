@@ -227,33 +227,49 @@ void FrameRenderer::prefetch(const Camera& camera) {
   ActiveFrame& a = *mActive;
   std::size_t frameResident = 0;
   for (std::uint32_t page : a.pages) frameResident += page != kNotResident;
+  if (frameResident == a.pages.size()) return;  // warm: nothing to find
   // The first pass's bricks: the first along each ray.
   std::vector<glm::uvec3> first;
   const std::uint32_t stride = firstBrickStride(mSettings.width, mSettings.height);
   for (std::uint32_t i :
        firstBricksAlongRays(camera, mSettings.width, mSettings.height, stride, mSource->header(), a.index->octree))
     if (a.pages[i] == kNotResident) first.push_back(a.index->bricks[i].coord);
-  // Those in view: boxes widened by the border a ray meets too.
-  const StoreHeader& header = mSource->header();
-  const double brickWorld = header.cellSize * header.brickSize;
-  const double margin = header.cellSize * mOverlap;
+  if (first.empty()) return;
+  // Those in view, where the pool holds the whole frame without evicting any of it: bricks
+  // streamed that no ray needs must not push out, now or in the passes after, those that one
+  // does (thickness would become best effort). Boxes widened by a cell for the ray-caster's
+  // float walk.
   std::vector<glm::uvec3> view;
-  for (std::size_t i = 0; i < a.pages.size(); ++i) {
-    const glm::dvec3 lo = header.origin + glm::dvec3(a.index->bricks[i].coord) * brickWorld;
-    if (a.pages[i] == kNotResident &&
-        boxMayBeInView(camera, mSettings.width, mSettings.height, Box{lo - margin, lo + brickWorld + margin}))
-      view.push_back(a.index->bricks[i].coord);
+  if (poolHoldsFrame(a.pages.size())) {
+    const StoreHeader& header = mSource->header();
+    const double brickWorld = header.cellSize * header.brickSize;
+    for (std::size_t i = 0; i < a.pages.size(); ++i) {
+      const glm::dvec3 lo = header.origin + glm::dvec3(a.index->bricks[i].coord) * brickWorld;
+      if (a.pages[i] == kNotResident && boxMayBeInView(camera, mSettings.width, mSettings.height,
+                                                       Box{lo - header.cellSize, lo + brickWorld + header.cellSize}))
+        view.push_back(a.index->bricks[i].coord);
+    }
   }
   // The whole view where it is at most twice the first pass's bricks: the passes after would
   // mostly find the rest behind them (a small frame's rays reach most of it), one pass each.
   // Beyond, the bricks that no ray reaches behind an opaque front would cost more than that.
-  const std::vector<glm::uvec3>& coords = view.size() <= 2 * first.size() ? view : first;
+  const std::vector<glm::uvec3>& coords = !view.empty() && view.size() <= 2 * first.size() ? view : first;
   // Where the pool cannot hold them with the frame's resident bricks, the passes stream what
   // the rays meet, as they come.
-  if (coords.empty() || frameResident + coords.size() > mPool.layout().slots) return;
+  if (frameResident + coords.size() > mPool.layout().slots) return;
   a.stats.bricksRequested += coords.size();
   mStreamer->request(coords);
   streamAndUpload(coords);
+}
+
+bool FrameRenderer::poolHoldsFrame(std::size_t frameBricks) const {
+  const PoolLayout& layout = mPool.layout();
+  if (frameBricks > layout.slots) return false;
+  if (!layout.attributes) return true;
+  // A brick has at most one attribute a stored cell, border included. Bricks of one frame that
+  // take at most half the ring never wrap around onto their own, whatever the ring held.
+  const std::uint64_t stored = mSource->header().brickSize + 2 * std::uint64_t(mOverlap);
+  return 2 * frameBricks * stored * stored * stored <= layout.attributeCapacity;
 }
 
 bool FrameRenderer::growPool(std::uint64_t wanted) {

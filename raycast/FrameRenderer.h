@@ -49,13 +49,13 @@ struct RenderSettings {
   /// (resolve() decides). FramePipeline's store gives bricks without it then
   /// (StoreBrickSource); the renderer follows what its source carries.
   bool attributes = true;
-  /// Whether trace() streams, before a frame's first pass, the bricks that pass would request
-  /// (firstBricksAlongRays: the first brick along each of a grid of the image's rays), or all
-  /// those in view (boxMayBeInView) where they are at most twice as many, when the pool holds
-  /// them beside the frame's resident ones (§3.3's loop streams the rest, what the rays meet
-  /// behind them). 20 M particles at 1280x720 on 2 cores: 30 bricks in view, 21 first; one
-  /// pass of 92 ms instead of three of 30, 72 and 18. 500 M: 1115 of the 2468 bricks in view
-  /// are reached, and only the first pass's bricks are streamed ahead.
+  /// Whether trace() streams, before a cold frame's first pass, the bricks that pass would
+  /// request (firstBricksAlongRays: the first brick along each of a grid of the image's rays),
+  /// when the pool holds them beside the frame's resident ones; or all those in view
+  /// (boxMayBeInView) where they are at most twice as many and the pool holds the whole frame
+  /// (poolHoldsFrame). §3.3's loop streams the rest, what the rays meet behind them. 20 M particles at 1280x720 on 2
+  /// cores: 30 bricks in view, 21 first; one pass of 92 ms instead of three of 30, 72 and 18. 500 M: 1115 of the 2468
+  /// bricks in view are reached, and only the first pass's bricks are streamed ahead.
   bool prefetch = true;
 };
 /// Throws InputError naming the setting that is out of range.
@@ -80,7 +80,7 @@ inline constexpr double kDefaultRadiusPerSpacing = 1.5;
 struct RenderStats {
   int passes = 0;
   bool converged = false;             ///< no ray pending at the end (false: pass limit reached)
-  std::uint64_t bricksRequested = 0;  ///< summed over passes
+  std::uint64_t bricksRequested = 0;  ///< summed over passes (and trace()'s prefetch)
   std::uint64_t bricksUploaded = 0;
   std::uint64_t bricksEvicted = 0;
   std::uint64_t bricksClassified = 0;  ///< foam classification (§3.5), of uploaded bricks
@@ -164,6 +164,9 @@ class FrameRenderer {
   void streamAndUpload(const std::vector<glm::uvec3>& coords);
   /// RenderSettings::prefetch for the frame begun.
   void prefetch(const Camera& camera);
+  /// Whether the pool holds a frame of `frameBricks` bricks all at once, so that none of them
+  /// evicts another: a slot each, and an attribute ring with room for twice the most they take.
+  bool poolHoldsFrame(std::size_t frameBricks) const;
 
   std::shared_ptr<BrickSource> mSource;
   std::unique_ptr<RaycastDevice> mDevice;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <random>
 
 #include <glm/geometric.hpp>
@@ -85,6 +86,7 @@ TEST(Camera, BoxMayBeInViewDropsBoxesBehindAndBesideTheEyeAndKeepsOneAroundIt) {
   const auto at = [](glm::dvec3 centre, double half) { return Box{centre - half, centre + half}; };
   EXPECT_TRUE(boxMayBeInView(camera, 160, 90, at({0, 0, 0}, 0.5)));
   EXPECT_FALSE(boxMayBeInView(camera, 160, 90, at({0, 0, 10}, 0.5))) << "behind";
+  EXPECT_FALSE(boxMayBeInView(camera, 160, 90, at({0, 0, 8}, 2.5))) << "behind, across the view's axis";
   EXPECT_FALSE(boxMayBeInView(camera, 160, 90, at({0, 4, 0}, 0.5))) << "above the top edge";
   EXPECT_TRUE(boxMayBeInView(camera, 160, 90, at({0, 0, 5}, 0.1))) << "around the eye";
   // The image's aspect widens the view: x = 2.5 at distance 5 is out of a square image only.

@@ -205,7 +205,7 @@ TEST(FrameRenderer, BricksStreamedBeforeTheFirstPassSaveAPassAndGiveTheRequestLo
   row.fovYDegrees = 15;
   Camera inside = whole;
   inside.eye = bounds.min + bounds.extent() * 0.45;
-  for (const Camera& camera : {whole, row, inside}) expectPrefetchSavesPasses(store, camera, testing::smallSettings());
+  for (const Camera& camera : {row, inside}) expectPrefetchSavesPasses(store, camera, testing::smallSettings());
   // The whole frame in view, 27 bricks, is less than twice the first pass's: all streamed, one pass.
   const RenderStats all = expectPrefetchSavesPasses(store, whole, testing::smallSettings()).first;
   EXPECT_EQ(all.passes, 1);

@@ -88,7 +88,9 @@ TEST_P(GpuRaycasterScenes, EqualsTheCpuReference) {
   for (std::size_t i = 0; i < particles.size(); ++i) velocities.push_back({speed(rng), speed(rng), speed(rng)});
   BrickStore store = testing::makeStore(dir / "store", {particles}, extent, seed % 2 ? 32 : 64, {velocities});
   RenderSettings settings = testing::smallSettings();
-  settings.prefetch = false;  // both devices take the request loop's passes, one by one
+  // Seed 1 compares the request loop's passes one by one: with the prefetch its cold frame is
+  // a pass that meets the llvmpipe divergence (README, "Known divergence on llvmpipe").
+  settings.prefetch = seed != 1;
   settings.radius = seed % 2 ? 1.5f : 0.8f;
   settings.jitter = seed % 3 ? 0.4f : 0.0f;
   GPU_RENDERER(gpu, store, settings);
