@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <thread>
-#include <unordered_map>
+#include <unordered_set>
 
 #include <glm/trigonometric.hpp>
 #include <glm/vector_relational.hpp>
@@ -383,8 +383,8 @@ void FrameRenderer::streamAndUpload(const std::vector<glm::uvec3>& coords) {
   ActiveFrame& a = *mActive;
   // Convert (or fetch from the CPU cache) every requested brick before the next pass.
   const auto streamStart = Clock::now();
-  std::unordered_map<BrickKey, bool, BrickKeyHash> wanted;
-  for (glm::uvec3 coord : coords) wanted.emplace(BrickKey{a.frame, coord}, false);
+  std::unordered_set<BrickKey, BrickKeyHash> wanted;
+  for (glm::uvec3 coord : coords) wanted.insert(BrickKey{a.frame, coord});
   std::vector<std::shared_ptr<const ConvertedBrick>> bricks;
   while (bricks.size() < wanted.size()) {
     mStreamer->waitIdle();
