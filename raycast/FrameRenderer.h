@@ -54,9 +54,9 @@ struct RenderSettings {
   /// when the pool holds them beside the frame's resident ones; or all those in view
   /// (boxMayBeInView) where they are at most twice as many and the pool holds the whole frame
   /// (poolHoldsFrame). §3.3's loop streams the rest, what the rays meet behind them. 20 M
-  /// particles at 1280x720 on 2 cores: 30 bricks in view, 21 first; one pass of 92 ms instead of
-  /// three of 30, 72 and 18. 500 M: 1115 of the 2468 bricks in view are reached, and only the
-  /// first pass's 453 are streamed ahead.
+  /// particles at 1280x720 on 2 cores: 30 bricks in view, 21 first; one pass of 93 to 101 ms
+  /// instead of three of about 30, 72 and 18. 500 M: 1115 of the 2468 bricks in view are
+  /// reached, and only the first pass's 453 are streamed ahead.
   bool prefetch = true;
 };
 /// Throws InputError naming the setting that is out of range.
