@@ -5,11 +5,14 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cstdint>
 #include <cstdlib>
 #include <fstream>
+#include <sstream>
 
+#include "core/AtomicFile.h"
 #include "core/Elapsed.h"
 #include "core/Error.h"
 
@@ -85,10 +88,88 @@ std::optional<bool> hugePagePolicyFromEnvironment(const char* value) {
   throw InputError("FLIPSCOPE_HUGE_PAGES: on, off or auto, not '" + v + "'");
 }
 
+namespace {
+/// The first line of a remembered advice file.
+constexpr std::string_view kRememberedAdviceHeader = "flipscope huge page advice 1";
+
+/// `name` with every character but letters, digits, '.', '-' and '_' made '_'.
+std::string fileNamePart(std::string name) {
+  for (char& c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '-' && c != '_') c = '_';
+  return name;
+}
+}  // namespace
+
+std::optional<std::filesystem::path> rememberedAdvicePath() {
+  std::filesystem::path cache;
+  const char* xdg = std::getenv("XDG_CACHE_HOME");
+  const char* home = std::getenv("HOME");
+  if (xdg && std::filesystem::path(xdg).is_absolute()) {
+    cache = xdg;
+  } else if (home && std::filesystem::path(home).is_absolute()) {
+    cache = std::filesystem::path(home) / ".cache";
+  } else {
+    return std::nullopt;
+  }
+  char host[256] = {};
+  if (::gethostname(host, sizeof host - 1) != 0 || host[0] == 0) return std::nullopt;
+  return cache / "flipscope" / ("huge-page-advice-" + fileNamePart(host));
+}
+
+std::string currentBootId() {
+  std::ifstream in("/proc/sys/kernel/random/boot_id");
+  std::string id;
+  std::getline(in, id);
+  return id;
+}
+
+std::optional<bool> rememberedAdvice(const std::filesystem::path& file, std::string_view bootId) {
+  if (bootId.empty()) return std::nullopt;
+  std::error_code ec;
+  const auto written = std::filesystem::last_write_time(file, ec);
+  if (ec) return std::nullopt;
+  const auto age = std::filesystem::file_time_type::clock::now() - written;
+  if (std::chrono::duration<double>(age).count() > kRememberedAdviceSeconds) return std::nullopt;
+  std::ifstream in(file);
+  std::string header, boot, advice;
+  if (!std::getline(in, header) || !std::getline(in, boot) || !std::getline(in, advice)) return std::nullopt;
+  if (header != kRememberedAdviceHeader || boot != "boot " + std::string(bootId)) return std::nullopt;
+  if (advice == "advice on") return true;
+  if (advice == "advice off") return false;
+  return std::nullopt;
+}
+
+void rememberAdvice(const std::filesystem::path& file, std::string_view bootId, bool on,
+                    const FirstTouchSeconds& measured) {
+  try {
+    std::filesystem::create_directories(file.parent_path());
+    std::ostringstream text;
+    text << kRememberedAdviceHeader << "\nboot " << bootId << "\nadvice " << (on ? "on" : "off") << "\nfirst touch of "
+         << measured.bytes << " bytes: " << measured.plainPages << " s in 4 KiB pages, " << measured.hugePages
+         << " s advised\n";
+    writeTextAtomically(file, text.str());
+  } catch (const std::exception&) {
+    // Measured again by the next command.
+  }
+}
+
 bool chooseHugePageAdvice() {
   const std::optional<bool> asked = hugePagePolicyFromEnvironment(std::getenv("FLIPSCOPE_HUGE_PAGES"));
-  const bool on =
-      asked ? *asked : transparentHugePagesAvailable() && hugePagesWorthAdvising(measureFirstTouch(kHugePageBytes * 2));
+  bool on = false;
+  if (asked) {
+    on = *asked;
+  } else if (transparentHugePagesAvailable()) {
+    const std::optional<std::filesystem::path> memo = rememberedAdvicePath();
+    const std::string boot = currentBootId();
+    const std::optional<bool> remembered = memo ? rememberedAdvice(*memo, boot) : std::nullopt;
+    if (remembered) {
+      on = *remembered;
+    } else {
+      const FirstTouchSeconds measured = measureFirstTouch(kHugePageBytes * 2);
+      on = hugePagesWorthAdvising(measured);
+      if (memo && !boot.empty()) rememberAdvice(*memo, boot, on, measured);
+    }
+  }
   setHugePageAdvice(on);
   return on;
 }

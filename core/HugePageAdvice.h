@@ -20,12 +20,21 @@
 // probed twice, and plain pages again where they look slow, the faster time kept, so one
 // preemption does not decide.
 //
-// FLIPSCOPE_HUGE_PAGES=on|off|auto (default auto: measure) overrides the measurement.
+// The probe costs 20 to 40 ms where plain pages are slow (on the VM of 2026-12-07 its two plain
+// touches took 10 and 13 ms), and every command paid it: `bench render`'s convert plus first
+// image twice. The measured choice is therefore remembered for the rest of the boot, for at most
+// kRememberedAdviceSeconds, in a small file per host (rememberedAdvicePath): a 10 k particle
+// convert took 0.07 s against 0.09 s measuring each time (eight runs each, alternating).
+//
+// FLIPSCOPE_HUGE_PAGES=on|off|auto (default auto: measure, or what this boot measured) overrides
+// the measurement.
 #pragma once
 
 #include <cstddef>
+#include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 
 namespace flipscope {
 
@@ -67,8 +76,31 @@ bool hugePagesWorthAdvising(const FirstTouchSeconds& measured);
 /// InputError, naming the variable, for another value.
 std::optional<bool> hugePagePolicyFromEnvironment(const char* value);
 
-/// Sets the advice for this process: as FLIPSCOPE_HUGE_PAGES says, else measured
-/// (measureFirstTouch of 4 MiB, about 10 to 40 ms). Returns what it chose.
+/// How long a measured advice is taken as this machine's, within one boot: a day, so that a VM
+/// moved to another host without a reboot is measured again.
+inline constexpr double kRememberedAdviceSeconds = 24 * 3600;
+
+/// Where the measured advice is remembered: `$XDG_CACHE_HOME/flipscope/huge-page-advice-<host>`
+/// (an absolute XDG_CACHE_HOME only, as the XDG spec says), else under `$HOME/.cache`; nullopt
+/// without either. Named by host, so that a home directory shared by a farm's nodes keeps one
+/// file each.
+std::optional<std::filesystem::path> rememberedAdvicePath();
+
+/// This boot's id (/proc/sys/kernel/random/boot_id), empty where there is none.
+std::string currentBootId();
+
+/// The advice `file` remembers for boot `bootId`: nullopt where the file is missing, unreadable,
+/// not in rememberAdvice's format, of another boot, or older than kRememberedAdviceSeconds.
+std::optional<bool> rememberedAdvice(const std::filesystem::path& file, std::string_view bootId);
+
+/// Writes what rememberedAdvice reads (atomically; its directory created). Never throws: a cache
+/// that cannot be written only means measuring again.
+void rememberAdvice(const std::filesystem::path& file, std::string_view bootId, bool on,
+                    const FirstTouchSeconds& measured);
+
+/// Sets the advice for this process: as FLIPSCOPE_HUGE_PAGES says; else as this boot measured
+/// (rememberedAdvice); else measured (measureFirstTouch of 4 MiB, about 10 to 40 ms) and
+/// remembered. Returns what it chose.
 bool chooseHugePageAdvice();
 
 }  // namespace flipscope

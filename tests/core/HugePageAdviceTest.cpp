@@ -3,11 +3,16 @@
 #include <gtest/gtest.h>
 #include <sys/mman.h>
 
+#include <chrono>
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 
+#include "TestSupport.h"
+#include "core/AtomicFile.h"
 #include "core/Error.h"
 #include "core/HugePageAdvice.h"
 
@@ -56,6 +61,81 @@ TEST(HugePageAdvice, ThePolicyVariableDecidesWithoutMeasuring) {
   ::setenv("FLIPSCOPE_HUGE_PAGES", "sometimes", 1);
   EXPECT_THROW(chooseHugePageAdvice(), InputError);
   ::unsetenv("FLIPSCOPE_HUGE_PAGES");
+  setHugePageAdvice(false);
+}
+
+TEST(HugePageAdvice, TheRememberedAdviceIsThisBootsOnlyAndAnythingElseIsMeasuredAgain) {
+  testing::TempDir dir("advice");
+  const std::filesystem::path file = dir / "cache/flipscope/huge-page-advice-host";
+  EXPECT_EQ(rememberedAdvice(file, "boot-a"), std::nullopt);  // none yet
+  const FirstTouchSeconds measured{.bytes = 4 << 20, .plainPages = 0.011, .hugePages = 0.0005};
+  rememberAdvice(file, "boot-a", true, measured);
+  EXPECT_EQ(rememberedAdvice(file, "boot-a"), true);
+  EXPECT_EQ(rememberedAdvice(file, "boot-b"), std::nullopt);  // another boot
+  EXPECT_EQ(rememberedAdvice(file, ""), std::nullopt);        // no boot id: nothing is remembered
+  rememberAdvice(file, "boot-a", false, measured);
+  EXPECT_EQ(rememberedAdvice(file, "boot-a"), false);
+  EXPECT_NE(readTextFile(file, "advice").find("first touch of 4194304 bytes: 0.011 s in 4 KiB pages"),
+            std::string::npos)
+      << readTextFile(file, "advice");
+  // Older than a day: measured again.
+  std::filesystem::last_write_time(file, std::filesystem::file_time_type::clock::now() -
+                                             std::chrono::seconds(static_cast<long>(kRememberedAdviceSeconds) + 60));
+  EXPECT_EQ(rememberedAdvice(file, "boot-a"), std::nullopt);
+  // Not the format: cut short, another header, another word.
+  for (const char* text :
+       {"flipscope huge page advice 1\nboot boot-a\n", "flipscope huge page advice 2\nboot boot-a\nadvice on\n",
+        "flipscope huge page advice 1\nboot boot-a\nadvice yes\n"}) {
+    writeTextAtomically(file, text);
+    EXPECT_EQ(rememberedAdvice(file, "boot-a"), std::nullopt) << text;
+  }
+  // A place that cannot be written (its parent a file): nothing thrown, nothing remembered.
+  writeTextAtomically(dir / "plain", "x");
+  EXPECT_NO_THROW(rememberAdvice(dir / "plain/huge-page-advice-host", "boot-a", true, measured));
+  EXPECT_EQ(rememberedAdvice(dir / "plain/huge-page-advice-host", "boot-a"), std::nullopt);
+}
+
+TEST(HugePageAdvice, TheCacheIsXdgCacheHomesWhenAbsoluteElseHomesAndNamedByHost) {
+  testing::TempDir dir("advice-path");
+  const testing::ScopedEnvironment home("HOME", (dir / "home").string());
+  {
+    const testing::ScopedEnvironment xdg("XDG_CACHE_HOME", (dir / "xdg").string());
+    const auto path = rememberedAdvicePath();
+    ASSERT_TRUE(path);
+    EXPECT_EQ(path->parent_path(), dir / "xdg/flipscope");
+    EXPECT_EQ(path->filename().string().rfind("huge-page-advice-", 0), 0u) << *path;
+    EXPECT_GT(path->filename().string().size(), std::string("huge-page-advice-").size()) << *path;
+  }
+  {
+    const testing::ScopedEnvironment xdg("XDG_CACHE_HOME", "relative/cache");  // ignored, as the spec says
+    const auto path = rememberedAdvicePath();
+    ASSERT_TRUE(path);
+    EXPECT_EQ(path->parent_path(), dir / "home/.cache/flipscope");
+  }
+  const testing::ScopedEnvironment relativeHome("HOME", "relative");
+  const testing::ScopedEnvironment xdg("XDG_CACHE_HOME", "");
+  EXPECT_EQ(rememberedAdvicePath(), std::nullopt);
+}
+
+TEST(HugePageAdvice, ChoosingTakesThisBootsRememberedAdviceElseMeasuresAndRemembersIt) {
+  if (!transparentHugePagesAvailable()) GTEST_SKIP() << "transparent huge pages are off on this machine";
+  const std::string boot = currentBootId();
+  if (boot.empty()) GTEST_SKIP() << "this machine has no boot id";
+  testing::TempDir dir("advice-choose");
+  const testing::ScopedEnvironment xdg("XDG_CACHE_HOME", dir.path().string());
+  ::unsetenv("FLIPSCOPE_HUGE_PAGES");
+  const auto file = rememberedAdvicePath();
+  ASSERT_TRUE(file);
+  // Whatever a measurement would say, each remembered value is taken as it is.
+  for (const bool remembered : {true, false}) {
+    rememberAdvice(*file, boot, remembered, {});
+    EXPECT_EQ(chooseHugePageAdvice(), remembered);
+  }
+  // Another boot's: measured, and this boot's remembered.
+  rememberAdvice(*file, boot + "-before", true, {});
+  const bool measured = chooseHugePageAdvice();
+  EXPECT_EQ(rememberedAdvice(*file, boot), measured);
+  EXPECT_NE(readTextFile(*file, "advice").find("first touch of 4194304 bytes"), std::string::npos);
   setHugePageAdvice(false);
 }
 
