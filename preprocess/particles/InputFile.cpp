@@ -20,6 +20,10 @@ namespace flipscope {
 namespace {
 
 constexpr std::size_t kBufferBytes = std::size_t(1) << 20;
+/// The first fill's: a header, or a file's magic, is read without a megabyte of fresh memory
+/// (on the development VM, whose first touch of fresh pages runs at 0.4 GB/s, 2.6 ms an open;
+/// a convert opens its input three or four times).
+constexpr std::size_t kFirstFillBytes = std::size_t(64) << 10;
 
 class FileByteSource final : public ByteSource {
  public:
@@ -174,7 +178,8 @@ void InputFile::seek(std::uint64_t offset) {
 bool InputFile::fill() {
   if (mOffset >= mBufferStart && mOffset < mBufferStart + mBuffer.size()) return true;
   if (mOffset >= mSize) return false;
-  mBuffer.resize(kBufferBytes);
+  mBuffer.resize(mFilled ? kBufferBytes : kFirstFillBytes);  // uninitialized: readAt writes it
+  mFilled = true;
   mBufferStart = mOffset;
   mBuffer.resize(mSource->readAt(mOffset, mBuffer.data(), mBuffer.size()));
   return !mBuffer.empty();

@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "core/UninitializedVector.h"
+
 namespace flipscope {
 
 /// Where an InputFile's bytes come from. Implementations: a file (pread), memory, and the
@@ -89,8 +91,9 @@ class InputFile {
   std::unique_ptr<ByteSource> mSource;
   std::uint64_t mSize = 0;
   std::uint64_t mOffset = 0;
-  std::vector<std::byte> mBuffer;  ///< bytes [mBufferStart, mBufferStart + mBuffer.size()) of the source
+  UninitializedVector<std::byte> mBuffer;  ///< bytes [mBufferStart, mBufferStart + mBuffer.size()) of the source
   std::uint64_t mBufferStart = 0;
+  bool mFilled = false;  ///< the buffer was filled once (the first fill is short)
   bool mLineTerminated = false;
 };
 

@@ -329,6 +329,41 @@ TEST(InputFile, ManyScatteredReadsOnTwoThreadsGiveEveryRangeAndAShortOneNamesThe
   expectFileError([&] { file.readScattered(offsets, 7, got.data()); }, {"bytes.bin", "file ends before byte 65540"});
 }
 
+// The buffer's first fill is short (64 KiB, a header's), the next ones 1 MiB: lines and small
+// reads across both kinds of fill, and seeks back into and out of the buffer, give every byte.
+TEST(InputFile, LinesAndSmallReadsAcrossTheShortFirstFillAndTheFullOnesGiveEveryByte) {
+  TempDir dir("fills");
+  std::string text;
+  for (int i = 0; text.size() < (std::size_t(5) << 19); ++i)  // 2.5 MiB of lines of 1 to 300 bytes
+    text += std::string(std::size_t(1 + (i * 7919) % 300), char('a' + i % 26)) + (i % 3 ? "\n" : "\r\n");
+  writeBytes(dir / "lines.txt", text);
+  InputFile file(dir / "lines.txt");
+  std::string expected, line;
+  std::size_t lines = 0;
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t end = text.find('\n', at);
+    expected = text.substr(at, end - at);
+    if (!expected.empty() && expected.back() == '\r') expected.pop_back();
+    ASSERT_TRUE(file.readLine(line, 1000)) << "line " << lines;
+    ASSERT_EQ(line, expected) << "line " << lines;
+    at = end + 1;
+    ++lines;
+  }
+  EXPECT_FALSE(file.readLine(line, 1000));
+  // Small reads of odd sizes from odd places: inside the first fill, across its end, across a
+  // full fill's end, and the file's last bytes.
+  for (const std::uint64_t at :
+       {std::uint64_t(0), std::uint64_t(65530), std::uint64_t(65536), std::uint64_t(65536 + (1 << 20) - 5),
+        std::uint64_t(text.size() - 9), std::uint64_t(7)}) {
+    file.seek(at);
+    std::string got(13, '\0');
+    const std::size_t n = file.read(got.data(), got.size());
+    const std::size_t want = std::min<std::size_t>(13, text.size() - at);
+    ASSERT_EQ(n, want) << "at " << at;
+    EXPECT_EQ(got.substr(0, n), text.substr(at, n)) << "at " << at;
+  }
+}
+
 TEST(ParticleSource, ChunkSizeDoesNotChangeTheParticles) {
   TempDir dir("chunks");
   for (const auto& path : writeEveryFormat(dir, randomParticles(2500, true, 31))) {
