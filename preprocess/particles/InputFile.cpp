@@ -1,6 +1,7 @@
 #include "preprocess/particles/InputFile.h"
 
 #include <fcntl.h>
+#include <sys/uio.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -73,6 +74,12 @@ class FileByteSource final : public ByteSource {
   bool randomAccess() const override { return true; }
   void willRead(std::span<const std::uint64_t> offsets, std::size_t bytes) override {
     for (std::uint64_t offset : offsets) ::posix_fadvise(mFd, off_t(offset), off_t(bytes), POSIX_FADV_WILLNEED);
+  }
+  bool readIfCached(std::uint64_t offset, void* data, std::size_t bytes) override {
+    // RWF_NOWAIT: EAGAIN (or a short read) where a page is not in the cache; EOPNOTSUPP where the
+    // kernel or the file system has no such read. Either way readAt reads it.
+    iovec range{data, bytes};
+    return ::preadv2(mFd, &range, 1, off_t(offset), RWF_NOWAIT) == ssize_t(bytes);
   }
 
  private:
@@ -214,11 +221,20 @@ void InputFile::readExact(void* data, std::size_t bytes, const char* what) {
 
 bool InputFile::readScattered(std::span<const std::uint64_t> offsets, std::size_t bytes, std::byte* data) {
   if (!mSource->randomAccess()) return false;
-  // Each thread announces its own reads, then reads them: the announcements (a system call
-  // each, about as long as a read when the file is cached) run on both threads too.
+  // Each thread reads what is in the page cache at once (readIfCached), then announces the rest
+  // (a system call each, about as long as a read of a cached range) and reads it: a cached file
+  // costs one system call a range, not two (the 5000 ranges of the particle spacing's sample of
+  // the 20 M particle PLY took 19 ms with an announcement each, 11 to 12 ms so).
   const auto readRanges = [&](std::size_t begin, std::size_t end) {
-    mSource->willRead(offsets.subspan(begin, end - begin), bytes);
+    std::vector<std::uint64_t> missed;
+    std::vector<std::size_t> missedIndex;
     for (std::size_t i = begin; i < end; ++i)
+      if (!mSource->readIfCached(offsets[i], data + i * bytes, bytes)) {
+        missed.push_back(offsets[i]);
+        missedIndex.push_back(i);
+      }
+    mSource->willRead(missed, bytes);
+    for (const std::size_t i : missedIndex)
       if (mSource->readAt(offsets[i], data + i * bytes, bytes) != bytes)
         throw FileError(mPath, "file ends before byte " + std::to_string(offsets[i] + bytes) +
                                    " (was it truncated while being read?)");

@@ -34,6 +34,14 @@ class ByteSource {
   /// A hint that the ranges of `bytes` bytes at `offsets` will be read soon: a file asks the
   /// kernel for all of them at once, so that an uncached disk serves them in parallel.
   virtual void willRead(std::span<const std::uint64_t> offsets, std::size_t bytes) { (void)offsets, (void)bytes; }
+  /// Reads the `bytes` bytes at `offset` into `data` where all of them can be had without waiting
+  /// for a disk (a file's pages in the page cache: one system call, no announcement first) and
+  /// returns true; else false, `data` undefined, for readAt to read them. Sources that cannot
+  /// tell return false. Thread safe where readAt is.
+  virtual bool readIfCached(std::uint64_t offset, void* data, std::size_t bytes) {
+    (void)offset, (void)data, (void)bytes;
+    return false;
+  }
 };
 
 class InputFile {

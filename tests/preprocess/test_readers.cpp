@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 
 #include "GzipTestWriter.h"
@@ -327,6 +328,28 @@ TEST(InputFile, ManyScatteredReadsOnTwoThreadsGiveEveryRangeAndAShortOneNamesThe
     ASSERT_EQ(std::memcmp(got.data() + i * 7, bytes.data() + offsets[i], 7), 0) << "range " << i;
   offsets.back() = bytes.size() - 3;  // ends past the file, on the second thread's share
   expectFileError([&] { file.readScattered(offsets, 7, got.data()); }, {"bytes.bin", "file ends before byte 65540"});
+}
+
+// Scattered ranges come from the page cache in one read each where cached, and through an
+// announcement and a read where not: either way, from a file dropped from the cache, then
+// cached, every range holds its bytes, those across a page boundary too.
+TEST(InputFile, ScatteredRangesOfAColdFileAndThenOfACachedOneGiveTheirBytes) {
+  TempDir dir("scattered-cold");
+  std::string bytes(std::size_t(4) << 20, '\0');
+  for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = char((i * 131) % 251);
+  writeBytes(dir / "bytes.bin", bytes);
+  std::vector<std::uint64_t> offsets;
+  for (std::uint64_t page = 1; page * 4096 + 16 < bytes.size(); page += 3) offsets.push_back(page * 4096 - 5);
+  ASSERT_GT(offsets.size(), 300u);
+  const bool cold = testing::dropFromPageCache(dir / "bytes.bin");
+  for (const char* state : {"cold", "cached"}) {
+    InputFile file(dir / "bytes.bin");
+    std::vector<std::byte> got(offsets.size() * 11);
+    ASSERT_TRUE(file.readScattered(offsets, 11, got.data())) << state;
+    for (std::size_t i = 0; i < offsets.size(); ++i)
+      ASSERT_EQ(std::memcmp(got.data() + i * 11, bytes.data() + offsets[i], 11), 0) << state << ", range " << i;
+  }
+  if (!cold) std::printf("note: the file could not be dropped from the page cache here (tmpfs?)\n");
 }
 
 // The buffer's first fill is short (64 KiB, a header's), the next ones 1 MiB: lines and small
