@@ -85,6 +85,12 @@ void CpuRaycaster::uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset
   }
 }
 
+void CpuRaycaster::uploadBricks(std::span<const BrickUpload> uploads) {
+  tbb::parallel_for(std::size_t(0), uploads.size(), [&](std::size_t i) {
+    uploadBrick(uploads[i].slot, uploads[i].attributeOffset, *uploads[i].brick);
+  });
+}
+
 void CpuRaycaster::classifyFoam(std::span<const std::uint32_t> slots, const FoamClassifyParams& params) {
   const PoolLayout& layout = mPool.layout;
   FLIPSCOPE_CHECK(layout.foam && params.subBricksPerSlot == layout.subBricksPerSlot &&

@@ -23,6 +23,9 @@ class CpuRaycaster : public RaycastDevice {
   void setOctree(std::span<const OctreeNode> nodes) override;
   void setPageTable(std::span<const std::uint32_t> pageTable) override;
   void uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset, const ConvertedBrick& brick) override;
+  /// In parallel: a slot's arrays (and march tables) are its own, and a batch's ring ranges
+  /// do not overlap.
+  void uploadBricks(std::span<const BrickUpload> uploads) override;
   void classifyFoam(std::span<const std::uint32_t> slots, const FoamClassifyParams& params) override;
   double lastClassifyMs() const override { return mLastClassifyMs; }
   std::vector<glm::uvec4> readFoam(std::uint32_t slot) override;

@@ -416,6 +416,7 @@ void FrameRenderer::upload(std::vector<std::shared_ptr<const ConvertedBrick>> br
   });
   const std::uint64_t batch = ++mBatch;
   std::vector<std::uint32_t> uploadedSlots;
+  std::vector<RaycastDevice::BrickUpload> uploads;
   std::vector<BrickKey> evicted;
   for (const auto& brick : bricks) {
     evicted.clear();
@@ -430,11 +431,14 @@ void FrameRenderer::upload(std::vector<std::shared_ptr<const ConvertedBrick>> br
       a.params.thicknessBestEffort = 1u;
     }
     if (!placement) break;  // the pool holds this pass's bricks only: the rest next pass
-    mDevice->uploadBrick(placement->slot, placement->attributeOffset, *brick);
+    uploads.push_back({placement->slot, placement->attributeOffset, brick.get()});
     a.pages[std::size_t(brickIndex(*brick))] = placement->slot;
     uploadedSlots.push_back(placement->slot);
     ++stats.bricksUploaded;
   }
+  // One batch's placements never evict each other (BrickPool::place): the device may write
+  // them all at once.
+  mDevice->uploadBricks(uploads);
   mDevice->setPageTable(a.pages);
   stats.uploadMs += msSince(uploadStart);
   // §3.5: the bricks uploaded in this pass are classified in one batch before the next trace.

@@ -39,6 +39,17 @@ class RaycastDevice {
   /// Writes a converted brick into `slot`; its attributes go to ring entries from `attributeOffset`.
   /// With a foam pool (PoolLayout::foam) its foam bit-brick becomes brick.foamKinds, or zeros.
   virtual void uploadBrick(std::uint32_t slot, std::uint64_t attributeOffset, const ConvertedBrick& brick) = 0;
+  /// One brick of uploadBricks().
+  struct BrickUpload {
+    std::uint32_t slot;
+    std::uint64_t attributeOffset;
+    const ConvertedBrick* brick;
+  };
+  /// uploadBrick() of each, into distinct slots and ring ranges (one batch's placements,
+  /// BrickPool::place), in any order: the CPU devices upload them on every core.
+  virtual void uploadBricks(std::span<const BrickUpload> uploads) {
+    for (const BrickUpload& u : uploads) uploadBrick(u.slot, u.attributeOffset, *u.brick);
+  }
   /// Foam classification (§3.5, raycast/glsl/FoamClassify.glsl) of the bricks uploaded into
   /// `slots`: their foam bit-bricks become the uploaded ones plus (params.classify = 1u) the
   /// classified cells, then their foam occupancy is built. Needs a foam pool; params.batchSubBricks must

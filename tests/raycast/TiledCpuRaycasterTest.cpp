@@ -11,6 +11,8 @@
 //    mean depth error stays below 1e-4 relative.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstring>
 #include <sstream>
 
 #include "RaycastScenes.h"
@@ -127,6 +129,55 @@ TEST_P(TiledCpuRaycasterScenes, EqualsTheReferenceColdAndWarm) {
     EXPECT_GE(agreement.close, agreement.bothHit - agreement.bothHit / 200) << agreement.firstFar;
     EXPECT_LT(agreement.depthError / std::max(1, agreement.bothHit), 1e-4);
   }
+}
+
+/// The fast device with the interface's upload of one brick after the other.
+class UploadingOneAtATime final : public TiledCpuRaycaster {
+ public:
+  void uploadBricks(std::span<const BrickUpload> uploads) override { RaycastDevice::uploadBricks(uploads); }
+};
+
+// A pass's bricks go into the pool on every core at once (CpuRaycaster::uploadBricks): each
+// slot's arrays, march tables and ring range are its own, so the image is the one of uploads
+// one at a time, bit for bit, with attributes, with foam classified after the upload, and
+// through a pool small enough to evict.
+TEST(TiledCpuRaycaster, BricksUploadedOnEveryCoreAtOnceGiveTheImageOfUploadsOneAtATime) {
+  TempDir dir("upload");
+  const float extent = 96.0f;
+  std::vector<glm::vec3> particles = testing::randomParticles(20000, 9, extent);
+  const auto ball = testing::ballParticles({45.0f, 50.0f, 40.0f}, 16.0f);
+  particles.insert(particles.end(), ball.begin(), ball.end());
+  std::vector<std::vector<glm::vec3>> velocities(1);
+  for (std::size_t i = 0; i < particles.size(); ++i) velocities[0].push_back({float(i % 97) / 32.0f, 0.0f, 0.0f});
+  BrickStore store = testing::makeStore(dir / "store", {particles}, extent, 32, velocities);
+  auto source = std::make_shared<StoreBrickSource>(store);
+  for (const FoamMode foam : {FoamMode::Keep, FoamMode::Volume})
+    for (const std::uint64_t budget : {std::uint64_t(0), std::uint64_t(6) << 20}) {
+      RenderSettings settings = testing::smallSettings(96, 64);
+      settings.radius = 1.2f;
+      settings.jitter = 0.3f;
+      settings.thicknessSaturationCells = 24.0f;
+      settings.foam.mode = foam;
+      if (budget) settings.gpuBudgetBytes = budget;
+      FrameRenderer oneAtATime(source, std::make_unique<UploadingOneAtATime>(), settings);
+      FrameRenderer atOnce(source, std::make_unique<TiledCpuRaycaster>(), settings);
+      for (const double a : {0.4, 2.5}) {
+        SCOPED_TRACE(std::string("foam ") + foamModeName(foam) + ", budget " + std::to_string(budget) + ", angle " +
+                     std::to_string(a));
+        Camera camera = frameOnBox(Box{{0, 0, 0}, {extent, extent, extent}}, 1.5);
+        camera.eye = camera.target + glm::dvec3(std::cos(a), 0.5, std::sin(a)) * 120.0;
+        const RenderResult expected = oneAtATime.render(0, camera);
+        const RenderResult actual = atOnce.render(0, camera);
+        ASSERT_TRUE(expected.stats.converged && actual.stats.converged);
+        EXPECT_EQ(actual.stats.bricksUploaded, expected.stats.bricksUploaded);
+        ASSERT_EQ(actual.hits.size(), expected.hits.size());
+        EXPECT_EQ(std::memcmp(actual.hits.data(), expected.hits.data(), actual.hits.size() * sizeof(RayHit)), 0);
+        EXPECT_GT(std::count_if(actual.hits.begin(), actual.hits.end(),
+                                [](const RayHit& h) { return h.status == kRayHit && h.normal.w > 0; }),
+                  std::ptrdiff_t(actual.hits.size() / 20))
+            << "hits with attributes must fill some of the image";
+      }
+    }
 }
 
 INSTANTIATE_TEST_SUITE_P(RandomScenes, TiledCpuRaycasterScenes,
