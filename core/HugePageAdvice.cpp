@@ -128,8 +128,9 @@ std::optional<bool> rememberedAdvice(const std::filesystem::path& file, std::str
   std::error_code ec;
   const auto written = std::filesystem::last_write_time(file, ec);
   if (ec) return std::nullopt;
-  const auto age = std::filesystem::file_time_type::clock::now() - written;
-  if (std::chrono::duration<double>(age).count() > kRememberedAdviceSeconds) return std::nullopt;
+  // A file dated ahead of this clock (a server's clock, `touch -d`) is no younger for it.
+  const double age = std::chrono::duration<double>(std::filesystem::file_time_type::clock::now() - written).count();
+  if (age < 0 || age > kRememberedAdviceSeconds) return std::nullopt;
   std::ifstream in(file);
   std::string header, boot, advice;
   if (!std::getline(in, header) || !std::getline(in, boot) || !std::getline(in, advice)) return std::nullopt;

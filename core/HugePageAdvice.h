@@ -90,7 +90,8 @@ std::optional<std::filesystem::path> rememberedAdvicePath();
 std::string currentBootId();
 
 /// The advice `file` remembers for boot `bootId`: nullopt where the file is missing, unreadable,
-/// not in rememberAdvice's format, of another boot, or older than kRememberedAdviceSeconds.
+/// not in rememberAdvice's format, of another boot, older than kRememberedAdviceSeconds, or dated
+/// in the future. Removing the file makes the next command measure again.
 std::optional<bool> rememberedAdvice(const std::filesystem::path& file, std::string_view bootId);
 
 /// Writes what rememberedAdvice reads (atomically; its directory created). Never throws: a cache

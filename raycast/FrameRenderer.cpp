@@ -418,9 +418,19 @@ void FrameRenderer::upload(std::vector<std::shared_ptr<const ConvertedBrick>> br
   std::vector<std::uint32_t> uploadedSlots;
   std::vector<RaycastDevice::BrickUpload> uploads;
   std::vector<BrickKey> evicted;
+  // A placement that throws (a brick larger than the ring) leaves the bricks placed before it
+  // listed as resident: they are written before the error goes on, as they were when each
+  // was uploaded as it was placed.
+  const auto uploadPlaced = [&] { mDevice->uploadBricks(uploads); };
   for (const auto& brick : bricks) {
     evicted.clear();
-    const auto placement = mPool.place(brick->key, brick->bits.attributes.size(), batch, evicted);
+    std::optional<BrickPool::Placement> placement;
+    try {
+      placement = mPool.place(brick->key, brick->bits.attributes.size(), batch, evicted);
+    } catch (...) {
+      uploadPlaced();
+      throw;
+    }
     for (const BrickKey& key : evicted) {
       ++stats.bricksEvicted;
       if (key.frame != a.frame) continue;
@@ -438,7 +448,7 @@ void FrameRenderer::upload(std::vector<std::shared_ptr<const ConvertedBrick>> br
   }
   // One batch's placements never evict each other (BrickPool::place): the device may write
   // them all at once.
-  mDevice->uploadBricks(uploads);
+  uploadPlaced();
   mDevice->setPageTable(a.pages);
   stats.uploadMs += msSince(uploadStart);
   // §3.5: the bricks uploaded in this pass are classified in one batch before the next trace.

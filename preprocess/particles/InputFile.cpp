@@ -77,9 +77,13 @@ class FileByteSource final : public ByteSource {
   }
   bool readIfCached(std::uint64_t offset, void* data, std::size_t bytes) override {
     // RWF_NOWAIT: EAGAIN (or a short read) where a page is not in the cache; EOPNOTSUPP where the
-    // kernel or the file system has no such read. Either way readAt reads it.
+    // kernel or the file system has no such read, and then never again. Either way readAt reads it.
+    if (!mNoWaitReads.load(std::memory_order_relaxed)) return false;
     iovec range{data, bytes};
-    return ::preadv2(mFd, &range, 1, off_t(offset), RWF_NOWAIT) == ssize_t(bytes);
+    const ssize_t n = ::preadv2(mFd, &range, 1, off_t(offset), RWF_NOWAIT);
+    if (n < 0 && (errno == EOPNOTSUPP || errno == EINVAL || errno == ENOSYS))
+      mNoWaitReads.store(false, std::memory_order_relaxed);
+    return n == ssize_t(bytes);
   }
 
  private:
@@ -137,6 +141,7 @@ class FileByteSource final : public ByteSource {
   std::uint64_t mSize = 0;
   std::atomic<std::uint64_t> mReadEnd{0};   ///< where the last read ended
   std::atomic<std::uint64_t> mAheadEnd{0};  ///< how far the read-ahead was asked for
+  std::atomic<bool> mNoWaitReads{true};     ///< preadv2(RWF_NOWAIT) works here (readIfCached)
   std::size_t mReadOnceAheadBytes;          ///< 0: the file may be read again
   int mDirectFd = -1;                       ///< opened with O_DIRECT: a file read once
   std::optional<PageCacheResidency> mResidency;  ///< with mDirectFd
@@ -188,7 +193,12 @@ bool InputFile::fill() {
   mBuffer.resize(mFilled ? kBufferBytes : kFirstFillBytes);  // uninitialized: readAt writes it
   mFilled = true;
   mBufferStart = mOffset;
-  mBuffer.resize(mSource->readAt(mOffset, mBuffer.data(), mBuffer.size()));
+  try {
+    mBuffer.resize(mSource->readAt(mOffset, mBuffer.data(), mBuffer.size()));
+  } catch (...) {
+    mBuffer.clear();  // nothing read is held: a read after the error asks the source again
+    throw;
+  }
   return !mBuffer.empty();
 }
 

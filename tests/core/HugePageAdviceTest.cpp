@@ -82,6 +82,10 @@ TEST(HugePageAdvice, TheRememberedAdviceIsThisBootsOnlyAndAnythingElseIsMeasured
   std::filesystem::last_write_time(file, std::filesystem::file_time_type::clock::now() -
                                              std::chrono::seconds(static_cast<long>(kRememberedAdviceSeconds) + 60));
   EXPECT_EQ(rememberedAdvice(file, "boot-a"), std::nullopt);
+  // Dated ahead of the clock: measured again too.
+  rememberAdvice(file, "boot-a", true, measured);
+  std::filesystem::last_write_time(file, std::filesystem::file_time_type::clock::now() + std::chrono::hours(2));
+  EXPECT_EQ(rememberedAdvice(file, "boot-a"), std::nullopt);
   // Not the format: cut short, another header, another word.
   for (const char* text :
        {"flipscope huge page advice 1\nboot boot-a\n", "flipscope huge page advice 2\nboot boot-a\nadvice on\n",

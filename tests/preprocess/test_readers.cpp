@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstdio>
@@ -330,6 +331,57 @@ TEST(InputFile, ManyScatteredReadsOnTwoThreadsGiveEveryRangeAndAShortOneNamesThe
   expectFileError([&] { file.readScattered(offsets, 7, got.data()); }, {"bytes.bin", "file ends before byte 65540"});
 }
 
+/// Bytes in memory that say half their ranges are cached: readIfCached gives the ranges at even
+/// multiples of `stride` and scribbles over the others before turning them away, which willRead
+/// and readAt must then announce and read.
+class HalfCachedBytes final : public ByteSource {
+ public:
+  HalfCachedBytes(std::string bytes, std::uint64_t stride) : mBytes(std::move(bytes)), mStride(stride) {}
+  std::uint64_t size() const override { return mBytes.size(); }
+  std::size_t readAt(std::uint64_t offset, void* data, std::size_t bytes) override {
+    ++reads;
+    const std::size_t n = offset >= mBytes.size() ? 0 : std::min<std::size_t>(bytes, mBytes.size() - offset);
+    std::memcpy(data, mBytes.data() + offset, n);
+    return n;
+  }
+  bool randomAccess() const override { return true; }
+  void willRead(std::span<const std::uint64_t> offsets, std::size_t) override {
+    announced += offsets.size();
+    for (const std::uint64_t offset : offsets)
+      if ((offset / mStride) % 2 == 0) ++announcedCached;
+  }
+  bool readIfCached(std::uint64_t offset, void* data, std::size_t bytes) override {
+    if ((offset / mStride) % 2 == 0) return readAt(offset, data, bytes) == bytes;
+    std::memset(data, 0xaa, bytes);
+    return false;
+  }
+  std::atomic<std::size_t> reads{0}, announced{0}, announcedCached{0};
+
+ private:
+  std::string mBytes;
+  std::uint64_t mStride;
+};
+
+// Ranges the source has cached are read once; the others (scribbled over by the failed try) are
+// announced and read: on two threads, every range holds its bytes.
+TEST(InputFile, ScatteredRangesTheSourceHasNotCachedAreAnnouncedAndReadAgain) {
+  std::string bytes(std::size_t(1) << 16, '\0');
+  for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = char((i * 7) % 253);
+  auto source = std::make_unique<HalfCachedBytes>(bytes, 16);
+  HalfCachedBytes& half = *source;
+  InputFile file("half-cached.bin", std::move(source));
+  std::vector<std::uint64_t> offsets;
+  for (std::uint64_t at = 0; at + 16 <= bytes.size(); at += 16) offsets.push_back(at);
+  ASSERT_GT(offsets.size(), 2048u);  // both threads' shares
+  std::vector<std::byte> got(offsets.size() * 9);
+  ASSERT_TRUE(file.readScattered(offsets, 9, got.data()));
+  for (std::size_t i = 0; i < offsets.size(); ++i)
+    ASSERT_EQ(std::memcmp(got.data() + i * 9, bytes.data() + offsets[i], 9), 0) << "range " << i;
+  EXPECT_EQ(half.announced.load(), offsets.size() / 2);
+  EXPECT_EQ(half.announcedCached.load(), 0u);
+  EXPECT_EQ(half.reads.load(), offsets.size());  // each range read once: from the cache, or after
+}
+
 // Scattered ranges come from the page cache in one read each where cached, and through an
 // announcement and a read where not: either way, from a file dropped from the cache, then
 // cached, every range holds its bytes, those across a page boundary too.
@@ -352,8 +404,8 @@ TEST(InputFile, ScatteredRangesOfAColdFileAndThenOfACachedOneGiveTheirBytes) {
   if (!cold) std::printf("note: the file could not be dropped from the page cache here (tmpfs?)\n");
 }
 
-// The buffer's first fill is short (64 KiB, a header's), the next ones 1 MiB: lines and small
-// reads across both kinds of fill, and seeks back into and out of the buffer, give every byte.
+// The buffer's first fill is short (64 KiB, a header's), the next ones 1 MiB: lines, and small
+// reads across the end of each kind of fill, give every byte.
 TEST(InputFile, LinesAndSmallReadsAcrossTheShortFirstFillAndTheFullOnesGiveEveryByte) {
   TempDir dir("fills");
   std::string text;
@@ -373,18 +425,20 @@ TEST(InputFile, LinesAndSmallReadsAcrossTheShortFirstFillAndTheFullOnesGiveEvery
     ++lines;
   }
   EXPECT_FALSE(file.readLine(line, 1000));
-  // Small reads of odd sizes from odd places: inside the first fill, across its end, across a
-  // full fill's end, and the file's last bytes.
-  for (const std::uint64_t at :
-       {std::uint64_t(0), std::uint64_t(65530), std::uint64_t(65536), std::uint64_t(65536 + (1 << 20) - 5),
-        std::uint64_t(text.size() - 9), std::uint64_t(7)}) {
-    file.seek(at);
-    std::string got(13, '\0');
-    const std::size_t n = file.read(got.data(), got.size());
-    const std::size_t want = std::min<std::size_t>(13, text.size() - at);
-    ASSERT_EQ(n, want) << "at " << at;
-    EXPECT_EQ(got.substr(0, n), text.substr(at, n)) << "at " << at;
+  // Small reads in order on a file opened afresh: inside the first fill, across its end into a
+  // full one, across that one's end, and the file's last bytes.
+  InputFile fresh(dir / "lines.txt");
+  std::uint64_t at = 0;
+  for (const std::size_t n : {std::size_t(65530), std::size_t(13), std::size_t((1 << 20) - 20), std::size_t(13)}) {
+    std::string got(n, '\0');
+    ASSERT_EQ(fresh.read(got.data(), n), n) << "at " << at;
+    ASSERT_EQ(got, text.substr(at, n)) << "at " << at;
+    at += n;
   }
+  fresh.seek(text.size() - 9);
+  std::string tail(13, '\0');
+  ASSERT_EQ(fresh.read(tail.data(), tail.size()), 9u);
+  EXPECT_EQ(tail.substr(0, 9), text.substr(text.size() - 9));
 }
 
 TEST(ParticleSource, ChunkSizeDoesNotChangeTheParticles) {

@@ -152,13 +152,19 @@ TEST(TiledCpuRaycaster, BricksUploadedOnEveryCoreAtOnceGiveTheImageOfUploadsOneA
   BrickStore store = testing::makeStore(dir / "store", {particles}, extent, 32, velocities);
   auto source = std::make_shared<StoreBrickSource>(store);
   for (const FoamMode foam : {FoamMode::Keep, FoamMode::Volume})
-    for (const std::uint64_t budget : {std::uint64_t(0), std::uint64_t(6) << 20}) {
+    for (const bool tight : {false, true}) {
       RenderSettings settings = testing::smallSettings(96, 64);
       settings.radius = 1.2f;
       settings.jitter = 0.3f;
       settings.thicknessSaturationCells = 24.0f;
       settings.foam.mode = foam;
-      if (budget) settings.gpuBudgetBytes = budget;
+      if (tight) {  // a pool of about 6 slots, for a frame of 27 bricks: passes evict
+        const PoolLayout roomy =
+            PoolLayout::forBudget(32, storedOverlap(settings), true, 64ull << 20, foam != FoamMode::Keep, true,
+                                  sphereReach(settings.radius, settings.jitter));
+        settings.gpuBudgetBytes = roomy.bytes() / roomy.slots * 6;
+      }
+      const std::uint64_t budget = settings.gpuBudgetBytes;
       FrameRenderer oneAtATime(source, std::make_unique<UploadingOneAtATime>(), settings);
       FrameRenderer atOnce(source, std::make_unique<TiledCpuRaycaster>(), settings);
       for (const double a : {0.4, 2.5}) {
@@ -170,6 +176,13 @@ TEST(TiledCpuRaycaster, BricksUploadedOnEveryCoreAtOnceGiveTheImageOfUploadsOneA
         const RenderResult actual = atOnce.render(0, camera);
         ASSERT_TRUE(expected.stats.converged && actual.stats.converged);
         EXPECT_EQ(actual.stats.bricksUploaded, expected.stats.bricksUploaded);
+        EXPECT_EQ(actual.stats.bricksEvicted, expected.stats.bricksEvicted);
+        if (a == 0.4) {  // the cold frame: batches of several bricks, and through the tight pool, evictions
+          EXPECT_GT(actual.stats.bricksUploaded, std::uint64_t(actual.stats.passes));
+          if (tight) {
+            EXPECT_GT(actual.stats.bricksEvicted, 0u);
+          }
+        }
         ASSERT_EQ(actual.hits.size(), expected.hits.size());
         EXPECT_EQ(std::memcmp(actual.hits.data(), expected.hits.data(), actual.hits.size() * sizeof(RayHit)), 0);
         EXPECT_GT(std::count_if(actual.hits.begin(), actual.hits.end(),
