@@ -91,6 +91,8 @@ std::optional<bool> hugePagePolicyFromEnvironment(const char* value) {
 namespace {
 /// The first line of a remembered advice file.
 constexpr std::string_view kRememberedAdviceHeader = "flipscope huge page advice 1";
+/// A remembered advice file is at most this long (it is about 150 bytes).
+constexpr std::uintmax_t kRememberedAdviceBytes = 4096;
 
 /// `name` with every character but letters, digits, '.', '-' and '_' made '_'.
 std::string fileNamePart(std::string name) {
@@ -131,6 +133,10 @@ std::optional<bool> rememberedAdvice(const std::filesystem::path& file, std::str
   // A file dated ahead of this clock (a server's clock, `touch -d`) is no younger for it.
   const double age = std::chrono::duration<double>(std::filesystem::file_time_type::clock::now() - written).count();
   if (age < 0 || age > kRememberedAdviceSeconds) return std::nullopt;
+  // A few lines of text: anything else (a device, a link to one, a large file) is not read.
+  if (!std::filesystem::is_regular_file(file, ec) || std::filesystem::file_size(file, ec) > kRememberedAdviceBytes ||
+      ec)
+    return std::nullopt;
   std::ifstream in(file);
   std::string header, boot, advice;
   if (!std::getline(in, header) || !std::getline(in, boot) || !std::getline(in, advice)) return std::nullopt;

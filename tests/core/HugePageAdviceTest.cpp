@@ -1,7 +1,10 @@
 // Huge page advice: the policy's values, the decision, and the advice reaching the kernel (the
 // mapping's VmFlags in /proc/self/smaps carry "hg" once advised MADV_HUGEPAGE).
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdint>
@@ -93,6 +96,17 @@ TEST(HugePageAdvice, TheRememberedAdviceIsThisBootsOnlyAndAnythingElseIsMeasured
     writeTextAtomically(file, text);
     EXPECT_EQ(rememberedAdvice(file, "boot-a"), std::nullopt) << text;
   }
+  // Not a few lines of text: a pipe that holds the right lines (read, it could as well wait for
+  // ever), and a large file that starts right.
+  ASSERT_EQ(::mkfifo((dir / "pipe").c_str(), 0600), 0);
+  const int pipe = ::open((dir / "pipe").c_str(), O_RDWR | O_NONBLOCK);
+  ASSERT_GE(pipe, 0);
+  const std::string lines = "flipscope huge page advice 1\nboot boot-a\nadvice on\n";
+  ASSERT_EQ(::write(pipe, lines.data(), lines.size()), ssize_t(lines.size()));
+  EXPECT_EQ(rememberedAdvice(dir / "pipe", "boot-a"), std::nullopt);
+  ::close(pipe);
+  writeTextAtomically(file, "flipscope huge page advice 1\nboot boot-a\nadvice on\n" + std::string(8192, '#'));
+  EXPECT_EQ(rememberedAdvice(file, "boot-a"), std::nullopt);
   // A place that cannot be written (its parent a file): nothing thrown, nothing remembered.
   writeTextAtomically(dir / "plain", "x");
   EXPECT_NO_THROW(rememberAdvice(dir / "plain/huge-page-advice-host", "boot-a", true, measured));
