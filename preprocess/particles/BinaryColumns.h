@@ -3,12 +3,14 @@
 // switch on the type runs once a column, never once a value. Private to flipscope::particles.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
+#include "preprocess/particles/InputFile.h"
 #include "preprocess/particles/ParticleSource.h"
 #include "preprocess/particles/ValueDecode.h"  // valueTypeBytes
 
@@ -30,6 +32,25 @@ inline void decodeVec3Column(ValueType type, ByteOrder order, const std::byte* f
                              std::size_t count, glm::vec3* out) {
   static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
   decodeColumn(type, order, first, stride, 3, count, reinterpret_cast<float*>(out));
+}
+
+/// Bytes of records a reader decodes at once: in the cache, and few reads.
+inline constexpr std::size_t kRecordBatchBytes = std::size_t(1) << 20;
+
+/// Reads `count` records of `stride` bytes from where `file` stands, kRecordBatchBytes of them
+/// (at least one record) at a time into `buffer`, and calls decode(records, n, first) for each
+/// batch of n records, the first of them record `first` of the `count`. Throws truncated(first)
+/// when the file ends inside the batch.
+template <class Decode, class Truncated>
+void readRecordBatches(InputFile& file, std::size_t stride, std::size_t count, std::vector<std::byte>& buffer,
+                       const Decode& decode, const Truncated& truncated) {
+  const std::size_t batch = std::max<std::size_t>(1, kRecordBatchBytes / stride);
+  for (std::size_t first = 0; first < count; first += batch) {
+    const std::size_t n = std::min(batch, count - first);
+    buffer.resize(n * stride);
+    if (file.read(buffer.data(), buffer.size()) != buffer.size()) throw truncated(first);
+    decode(buffer.data(), n, first);
+  }
 }
 
 /// Gives `chunk` the columns of `wanted` (names and arities; a chunk may come from another

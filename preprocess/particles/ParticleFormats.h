@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <memory>
@@ -13,6 +14,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/Error.h"
 #include "preprocess/particles/InputFile.h"
 #include "preprocess/particles/ParticleSource.h"
 #include "preprocess/particles/ParticleWriter.h"
@@ -78,6 +80,16 @@ std::unique_ptr<ParticleSource> openRealFlowParticles(InputFile file, const Read
 /// Maya particle disk cache .pdb, little-endian, written by a 32- or 64-bit build (PdbParticles.cpp).
 bool isPdb(std::span<const std::byte> head);
 std::unique_ptr<ParticleSource> openPdbParticles(InputFile file, const ReadOptions& options);
+
+/// A header's particle count that is known only at commit() (PLY's element vertex, legacy VTK's
+/// POINTS): the writer puts kCountFieldDigits zeros in its header, then this, the count in as
+/// many zero-padded decimal digits, in their place. Readers take the leading zeros as a decimal.
+inline constexpr std::size_t kCountFieldDigits = 15;
+inline std::string countField(std::uint64_t count) {
+  std::string digits = std::to_string(count);
+  FLIPSCOPE_CHECK(digits.size() <= kCountFieldDigits, "count=" << count);
+  return std::string(kCountFieldDigits - digits.size(), '0') + digits;
+}
 
 /// `text` with A-Z as a-z (names, keywords and extensions compare case-insensitively).
 std::string asciiLower(std::string_view text);

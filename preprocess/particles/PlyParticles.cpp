@@ -482,9 +482,6 @@ class PlyReader final : public ParticleSource {
   std::string mLine;
 };
 
-/// Digits of the zero-padded vertex count in the header written by PlyWriter.
-constexpr int kCountDigits = 15;
-
 class PlyWriter final : public ParticleWriter {
  public:
   PlyWriter(const std::filesystem::path& path, const WriteOptions& options)
@@ -494,7 +491,7 @@ class PlyWriter final : public ParticleWriter {
                                                                         : "binary_big_endian";
     std::string header = std::string("ply\nformat ") + format + " 1.0\ncomment written by flipscope\nelement vertex ";
     mCountOffset = header.size();
-    header += std::string(kCountDigits, '0') + "\nproperty float x\nproperty float y\nproperty float z\n";
+    header += std::string(kCountFieldDigits, '0') + "\nproperty float x\nproperty float y\nproperty float z\n";
     if (mVelocity) header += "property float vx\nproperty float vy\nproperty float vz\n";
     header += "end_header\n";
     mFile.write(header.data(), header.size());
@@ -514,9 +511,7 @@ class PlyWriter final : public ParticleWriter {
   }
 
   void commit() override {
-    std::string count = std::to_string(mCount);
-    FLIPSCOPE_CHECK(count.size() <= kCountDigits, "count=" << mCount);
-    count.insert(0, kCountDigits - count.size(), '0');
+    const std::string count = countField(mCount);
     mFile.writeAt(mCountOffset, count.data(), count.size());
     mFile.commit();
   }

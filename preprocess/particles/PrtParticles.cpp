@@ -37,7 +37,6 @@ constexpr std::uint64_t kBaseHeaderBytes = 56;
 constexpr std::uint64_t kChannelBytes = 44;
 constexpr std::int32_t kMaxChannels = 1 << 16;
 constexpr std::size_t kMaxRecordBytes = std::size_t(1) << 24;
-constexpr std::size_t kBatchBytes = std::size_t(1) << 20;
 constexpr std::size_t kInputBytes = 256 * 1024;
 
 constexpr ValueType kPrtTypes[] = {ValueType::Int16,   ValueType::Int32,   ValueType::Int64,  ValueType::Float16,
@@ -108,7 +107,7 @@ class PrtReader final : public ParticleSource {
     prepareColumns(chunk, mColumns, 0);
     std::size_t n = maxParticles;
     if (mCount >= 0) n = std::size_t(std::min<std::uint64_t>(n, std::uint64_t(mCount) - mNext));
-    const std::size_t batch = std::max<std::size_t>(1, kBatchBytes / mStride);
+    const std::size_t batch = std::max<std::size_t>(1, kRecordBatchBytes / mStride);
     std::size_t done = 0;
     while (done < n && !mEnded) {
       const std::size_t count = std::min(batch, n - done);

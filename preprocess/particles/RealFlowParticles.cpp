@@ -39,7 +39,6 @@ static_assert(std::endian::native == std::endian::little, "fields are read as st
 constexpr std::uint32_t kMagic = 0x00FABADA;
 constexpr std::size_t kNameBytes = 250;
 constexpr int kMaxVersion = 12;
-constexpr std::size_t kBatchBytes = std::size_t(1) << 20;
 
 struct RealFlowField {
   const char* name;
@@ -137,25 +136,24 @@ class RealFlowReader final : public ParticleSource {
     }
     chunk.positions.resize(n);
     if (mHasVelocity) chunk.velocities.resize(n);
-    const std::size_t batch = std::max<std::size_t>(1, kBatchBytes / mStride);
-    for (std::size_t begin = 0; begin < n; begin += batch) {
-      const std::size_t count = std::min(batch, n - begin);
-      mBuffer.resize(count * mStride);
-      if (mFile.read(mBuffer.data(), mBuffer.size()) != mBuffer.size())
-        throw fail("the file ends inside particle " + std::to_string(mNext + begin) + " of " + std::to_string(mCount) +
-                   " (was it truncated while being read?)");
-      const std::byte* records = mBuffer.data();
-      decodeVec3Column(mPosition.type, ByteOrder::Little, records + mPosition.offset, mStride, count,
-                       chunk.positions.data() + begin);
-      if (mHasVelocity)
-        decodeVec3Column(mVelocity.type, ByteOrder::Little, records + mVelocity.offset, mStride, count,
-                         chunk.velocities.data() + begin);
-      for (std::size_t k = 0; k < mSelected.size(); ++k) {
-        const Column& c = mSources[mSelected[k]];
-        decodeColumn(c.type, ByteOrder::Little, records + c.offset, mStride, c.arity, count,
-                     chunk.attributes[k].values.data() + begin * std::size_t(c.arity));
-      }
-    }
+    readRecordBatches(
+        mFile, mStride, n, mBuffer,
+        [&](const std::byte* records, std::size_t count, std::size_t begin) {
+          decodeVec3Column(mPosition.type, ByteOrder::Little, records + mPosition.offset, mStride, count,
+                           chunk.positions.data() + begin);
+          if (mHasVelocity)
+            decodeVec3Column(mVelocity.type, ByteOrder::Little, records + mVelocity.offset, mStride, count,
+                             chunk.velocities.data() + begin);
+          for (std::size_t k = 0; k < mSelected.size(); ++k) {
+            const Column& c = mSources[mSelected[k]];
+            decodeColumn(c.type, ByteOrder::Little, records + c.offset, mStride, c.arity, count,
+                         chunk.attributes[k].values.data() + begin * std::size_t(c.arity));
+          }
+        },
+        [&](std::size_t begin) {
+          return fail("the file ends inside particle " + std::to_string(mNext + begin) + " of " +
+                      std::to_string(mCount) + " (was it truncated while being read?)");
+        });
     mNext += n;
     if (mNext == mCount && !mTailChecked) checkTail();
     return true;

@@ -4,7 +4,7 @@
 // points are the particles.
 //
 // The point count comes before the points, and is known only at commit(): it is written as a
-// fixed-width field of kCountDigits zero-padded decimal digits and patched in place (legacy
+// fixed-width field of zero-padded decimal digits (countField) and patched in place (legacy
 // readers read the count as a decimal integer, leading zeros included). Velocities come after
 // every point, so they are kept, already big-endian, in a SpillFile (an unnamed temporary file
 // beside the output, 12 bytes a particle) and appended at commit(). Memory: a byte-swapped
@@ -27,7 +27,6 @@ namespace {
 static_assert(sizeof(glm::vec3) == 12 && std::endian::native == std::endian::little,
               "points are packed float triples, swapped to big-endian");
 
-constexpr int kCountDigits = 15;
 constexpr std::size_t kPieceParticles = 1 << 15;
 
 class VtkLegacyWriter final : public ParticleWriter {
@@ -36,7 +35,7 @@ class VtkLegacyWriter final : public ParticleWriter {
     if (options.velocity) mVelocities.emplace(path.parent_path());
     std::string header = "# vtk DataFile Version 3.0\nflipscope particles\nBINARY\nDATASET POLYDATA\nPOINTS ";
     mCountOffset = header.size();
-    header += std::string(kCountDigits, '0') + " float\n";
+    header += std::string(kCountFieldDigits, '0') + " float\n";
     mFile.write(header.data(), header.size());
   }
 
@@ -56,9 +55,7 @@ class VtkLegacyWriter final : public ParticleWriter {
   }
 
   void commit() override {
-    std::string count = std::to_string(mCount);
-    FLIPSCOPE_CHECK(count.size() <= kCountDigits, "count=" << mCount);
-    count.insert(0, kCountDigits - count.size(), '0');
+    const std::string count = countField(mCount);
     mFile.writeAt(mCountOffset, count.data(), count.size());
     if (mVelocities) {
       const std::string pointData = "\nPOINT_DATA " + std::to_string(mCount) + "\nVECTORS velocity float\n";

@@ -63,7 +63,6 @@ using houdini::ClassicType;
 constexpr char kBinaryMagic[5] = {'B', 'g', 'e', 'o', 'V'};
 constexpr std::int32_t kVersion = 5;
 constexpr std::int32_t kParticlePrimitive = 0x8000;  // "Part"
-constexpr std::size_t kBatchBytes = std::size_t(1) << 20;
 
 /// Big-endian fields read from an InputFile, with the messages of a classic bgeo.
 class Fields {
@@ -185,25 +184,24 @@ class ClassicBgeoReader final : public ParticleSource {
     }
     chunk.positions.resize(n);
     if (mHasVelocity) chunk.velocities.resize(n);
-    const std::size_t batch = std::max<std::size_t>(1, kBatchBytes / mStride);
-    for (std::size_t begin = 0; begin < n; begin += batch) {
-      const std::size_t count = std::min(batch, n - begin);
-      mBuffer.resize(count * mStride);
-      if (mFile.read(mBuffer.data(), mBuffer.size()) != mBuffer.size())
-        throw FileError(mFile.path(), "the file ends inside point " + std::to_string(mNext + begin) + " of " +
-                                          std::to_string(total) + " (was it truncated while being read?)");
-      const std::byte* records = mBuffer.data();
-      decodeVec3Column(ValueType::Float32, ByteOrder::Big, records, mStride, count, chunk.positions.data() + begin);
-      if (mHasVelocity)
-        decodeVec3Column(ValueType::Float32, ByteOrder::Big, records + mPoint[*mPlan.velocity].offset, mStride, count,
-                         chunk.velocities.data() + begin);
-      for (std::size_t k = 0; k < mSelected.size(); ++k) {
-        const ClassicAttribute& a = mPoint[mPlan.exposedSource[mSelected[k]]];
-        decodeColumn(a.type == ClassicType::Int ? ValueType::Int32 : ValueType::Float32, ByteOrder::Big,
-                     records + a.offset, mStride, a.size, count,
-                     chunk.attributes[k].values.data() + begin * std::size_t(a.size));
-      }
-    }
+    readRecordBatches(
+        mFile, mStride, n, mBuffer,
+        [&](const std::byte* records, std::size_t count, std::size_t begin) {
+          decodeVec3Column(ValueType::Float32, ByteOrder::Big, records, mStride, count, chunk.positions.data() + begin);
+          if (mHasVelocity)
+            decodeVec3Column(ValueType::Float32, ByteOrder::Big, records + mPoint[*mPlan.velocity].offset, mStride,
+                             count, chunk.velocities.data() + begin);
+          for (std::size_t k = 0; k < mSelected.size(); ++k) {
+            const ClassicAttribute& a = mPoint[mPlan.exposedSource[mSelected[k]]];
+            decodeColumn(a.type == ClassicType::Int ? ValueType::Int32 : ValueType::Float32, ByteOrder::Big,
+                         records + a.offset, mStride, a.size, count,
+                         chunk.attributes[k].values.data() + begin * std::size_t(a.size));
+          }
+        },
+        [&](std::size_t begin) {
+          return FileError(mFile.path(), "the file ends inside point " + std::to_string(mNext + begin) + " of " +
+                                             std::to_string(total) + " (was it truncated while being read?)");
+        });
     mNext += n;
     if (mNext == total && !mTailChecked) {
       checkTail();
