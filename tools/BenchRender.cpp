@@ -4,11 +4,14 @@
 // same run: `vdb_tool -read p.ply -points2ls ... -render ...` (OpenVDB's level-set meshing-free
 // path, itself faster than meshing). Reichl et al. 2014 §5 report 8.5 ms to 50 ms per frame on a
 // GTX 780 at 1280x720 (Table 3).
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <sstream>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -44,6 +47,7 @@ struct BenchRenderArgs {
   std::string gpuMem = "2G";
   bool skipVdbTool = false;
   std::string peer;  ///< "embree": the same particles through Embree in the same run
+  int peerRuns = 1;  ///< the peer comparison this many times, one after another
   bool json = false;
 };
 
@@ -208,6 +212,67 @@ PeerComparison compareWithEmbree(const fs::path& work, const fs::path& particles
   return c;
 }
 
+/// The median of `values` (the mean of the middle two for an even count); `values` not empty.
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+/// Over the runs of the peer comparison (with Embree): each target's ratio per run, its median
+/// and range, and in how many runs it was met. On a machine whose times swing from run to run,
+/// the spread says more than one run.
+struct PeerSummary {
+  struct Ratio {
+    std::vector<double> runs;
+    int met = 0;
+    double median() const { return tools::median(runs); }
+    double min() const { return *std::min_element(runs.begin(), runs.end()); }
+    double max() const { return *std::max_element(runs.begin(), runs.end()); }
+    nlohmann::json json() const {
+      return {{"runs", runs}, {"median", median()}, {"min", min()}, {"max", max()}, {"met_runs", met}};
+    }
+  };
+  Ratio warm;         ///< flipscope's warm frame over Embree's (met: at most 1)
+  Ratio sooner;       ///< Embree's build + first frame over flipscope's convert + first image (met: 10)
+  Ratio givenSooner;  ///< the same with the particle spacing given
+
+  /// nullopt when Embree is not built in.
+  static std::optional<PeerSummary> of(const std::vector<PeerComparison>& peers) {
+    if (peers.empty() || !peers.front().embree) return std::nullopt;
+    PeerSummary s;
+    for (const PeerComparison& p : peers) {
+      const double warm = p.flipscope.warmMeanMs() / p.embree->warmMeanMs();
+      const double sooner = p.embree->firstFrameSeconds / p.flipscopeFirst();
+      const double given = p.embree->firstFrameSeconds / p.givenFirst();
+      s.warm.runs.push_back(warm);
+      s.warm.met += warm <= 1.0;
+      s.sooner.runs.push_back(sooner);
+      s.sooner.met += sooner >= 10.0;
+      s.givenSooner.runs.push_back(given);
+      s.givenSooner.met += given >= 10.0;
+    }
+    return s;
+  }
+  nlohmann::json json() const {
+    return {{"runs", warm.runs.size()},
+            {"warm_frame_x_embree", warm.json()},
+            {"first_image_x_sooner", sooner.json()},
+            {"spacing_given_first_image_x_sooner", givenSooner.json()}};
+  }
+  void print() const {
+    const std::size_t n = warm.runs.size();
+    std::printf("\npeer over %zu runs: median, range, runs that met the target\n", n);
+    const auto row = [n](const char* what, const Ratio& r, int decimals) {
+      std::printf("  %-62s %6.*fx %6.*fx to %.*fx %3d of %zu\n", what, decimals, r.median(), decimals, r.min(),
+                  decimals, r.max(), r.met, n);
+    };
+    row("warm frame, x Embree's (target: at most 1)", warm, 2);
+    row("convert + first image, x sooner than Embree's (target: 10)", sooner, 1);
+    row("the same, the particle spacing given", givenSooner, 1);
+  }
+};
+
 void runBenchRender(const BenchRenderArgs& a) {
   const auto sizes = parseSizes(a.sizes);
   const fs::path work = a.workDir.empty() ? fs::temp_directory_path() / "flipscope-bench-render" : fs::path(a.workDir);
@@ -292,12 +357,14 @@ void runBenchRender(const BenchRenderArgs& a) {
     vdbTool = timeVdbTool(ply, work / "vdb_tool.png", fluid.cellSize(), 2.0, lastCamera, vw, vh);
   }
 
-  std::optional<PeerComparison> peer;
-  if (!a.peer.empty()) {
-    if (!a.json) std::fprintf(stderr, "bench render: the Embree peer at %ux%u ...\n", vw, vh);
-    peer = compareWithEmbree(work, ply, fluid.cellSize(), lastCamera, std::to_string(vw) + "x" + std::to_string(vh),
-                             a.orbitFrames, a.device);
+  std::vector<PeerComparison> peers;
+  for (int run = 1; !a.peer.empty() && run <= a.peerRuns; ++run) {
+    if (!a.json)
+      std::fprintf(stderr, "bench render: the Embree peer at %ux%u, run %d of %d ...\n", vw, vh, run, a.peerRuns);
+    peers.push_back(compareWithEmbree(work, ply, fluid.cellSize(), lastCamera,
+                                      std::to_string(vw) + "x" + std::to_string(vh), a.orbitFrames, a.device));
   }
+  const std::optional<PeerSummary> peerSummary = PeerSummary::of(peers);
 
   const SizeResult& main = results.back();
   if (a.json) {
@@ -323,7 +390,11 @@ void runBenchRender(const BenchRenderArgs& a) {
                             {"cold_bricks", r.cold.bricksUploaded},
                             {"frame_ms", r.frameMs},
                             {"trace_ms", r.traceMs}});
-    if (peer) j["peer"] = peer->json();
+    if (!peers.empty()) {
+      j["peer"] = peers.front().json();
+      for (const PeerComparison& p : peers) j["peer_runs"].push_back(p.json());
+      j["peer_summary"] = peerSummary ? peerSummary->json() : nlohmann::json(nullptr);
+    }
     printJson(j);
     return;
   }
@@ -351,7 +422,8 @@ void runBenchRender(const BenchRenderArgs& a) {
                 *vdbTool, main.firstImageSeconds, *vdbTool / main.firstImageSeconds);
   else if (!a.skipVdbTool)
     std::printf("\nvdb_tool not found (Debian package libopenvdb-tools): no comparison\n");
-  if (peer) peer->print();
+  for (const PeerComparison& p : peers) p.print();
+  if (peerSummary && peers.size() > 1) peerSummary->print();
   std::printf("images in %s\n", work.c_str());
 }
 
@@ -376,6 +448,11 @@ void addBenchRenderCommand(CLI::App& bench) {
                   "Also render the same particles with this peer, in the same run: embree (Embree 3 sphere points, "
                   "when built in), beside flipscope's convert and CPU ray-caster")
       ->check(CLI::IsMember({"embree"}));
+  cmd->add_option("--peer-runs", args->peerRuns,
+                  "Run the peer comparison this many times, one after another, and print each target's median, "
+                  "range and the runs that met it")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
   cmd->add_flag("--json", args->json, "Machine-readable output");
   cmd->callback([args] { runBenchRender(*args); });
 }

@@ -5,9 +5,10 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
-#include <cstdlib>
 #include <cmath>
+#include <cstdlib>
 #include <string>
+#include <vector>
 
 #include <png.h>
 
@@ -35,8 +36,10 @@ std::vector<bool> covered(const std::filesystem::path& path, std::uint32_t& widt
 TEST(BenchRenderPeer, EmbreeAndFlipscopeRenderTheSameParticlesWithTheSameCamera) {
   flipscope::testing::TempDir dir("bench-peer");
   const flipscope::testing::CommandRun run = flipscope::testing::runFlipscope(
-      "bench render --particles 200k --sizes 96x54 --orbit-frames 2 --no-vdb-tool --device cpu --peer embree --json "
-      "--work-dir '" + dir.path().string() + "'");
+      "bench render --particles 200k --sizes 96x54 --orbit-frames 2 --no-vdb-tool --device cpu --peer embree "
+      "--peer-runs 3 --json "
+      "--work-dir '" +
+      dir.path().string() + "'");
   ASSERT_EQ(run.exitCode, 0) << run.output;
   const auto j = nlohmann::json::parse(run.output);
   ASSERT_TRUE(j.contains("peer")) << run.output;
@@ -61,6 +64,33 @@ TEST(BenchRenderPeer, EmbreeAndFlipscopeRenderTheSameParticlesWithTheSameCamera)
   }
   const auto& embree = peer["embree"];
   std::uint32_t w = 0, h = 0;
+  // Each run in turn, the first also as "peer"; the summary's medians, ranges and counts are of them.
+  ASSERT_EQ(j["peer_runs"].size(), 3u) << run.output;
+  EXPECT_EQ(j["peer_runs"][0], peer);
+  const auto& summary = j["peer_summary"];
+  ASSERT_EQ(summary["runs"], 3) << run.output;
+  for (const char* target : {"warm_frame_x_embree", "first_image_x_sooner", "spacing_given_first_image_x_sooner"}) {
+    const auto& t = summary[target];
+    std::vector<double> ratios;
+    for (std::size_t r = 0; r < 3; ++r) {
+      const auto& p = j["peer_runs"][r];
+      const double embreeFirst = p["embree"]["build_and_first_frame_s"].get<double>();
+      ratios.push_back(std::string(target) == "warm_frame_x_embree"
+                           ? p["flipscope_warm_frame_ms"].get<double>() / p["embree"]["warm_frame_ms"].get<double>()
+                       : std::string(target) == "first_image_x_sooner"
+                           ? embreeFirst / p["flipscope_convert_and_first_image_s"].get<double>()
+                           : embreeFirst / p["flipscope_spacing_given_convert_and_first_image_s"].get<double>());
+      EXPECT_NEAR(t["runs"][r].get<double>(), ratios.back(), 1e-9 * ratios.back()) << target << " run " << r;
+    }
+    std::sort(ratios.begin(), ratios.end());
+    EXPECT_DOUBLE_EQ(t["median"].get<double>(), ratios[1]) << target;
+    EXPECT_DOUBLE_EQ(t["min"].get<double>(), ratios[0]) << target;
+    EXPECT_DOUBLE_EQ(t["max"].get<double>(), ratios[2]) << target;
+    const bool warm = std::string(target) == "warm_frame_x_embree";
+    EXPECT_EQ(t["met_runs"].get<int>(),
+              std::count_if(ratios.begin(), ratios.end(), [warm](double x) { return warm ? x <= 1.0 : x >= 10.0; }))
+        << target;
+  }
   EXPECT_EQ(embree["version"].get<std::string>().rfind("Embree 3.", 0), 0u);
   EXPECT_GE(embree["build_and_first_frame_s"].get<double>(), embree["build_s"].get<double>());
   EXPECT_GT(embree["read_s"].get<double>(), 0.0);
