@@ -5,6 +5,7 @@
 
 #include "pipeline/FramePipeline.h"
 #include "streaming/BrickSource.h"
+#include "tools/BenchStatistics.h"
 
 namespace flipscope::tools {
 
@@ -61,10 +62,6 @@ FoamTraceTiming timeFoamAndAbsorption(const std::filesystem::path& store, Device
   }
   for (int i = 0; i < std::max(frames, 1); ++i)
     for (Variant& v : variants) v.ms.push_back(v.renderer->render(0, camera).stats.traceMs);
-  auto median = [](std::vector<double> ms) {
-    std::sort(ms.begin(), ms.end());
-    return ms[ms.size() / 2];
-  };
   timing.spheresMs = median(variants[0].ms);
   timing.absorptionMs = median(variants[1].ms);
   timing.removeMs = median(variants[2].ms);

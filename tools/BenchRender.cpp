@@ -26,6 +26,7 @@
 #include "raycast/GpuRaycaster.h"
 #include "tools/BenchFoam.h"
 #include "tools/BenchFrameStage.h"
+#include "tools/BenchStatistics.h"
 #include "tools/ChildProcess.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
@@ -106,6 +107,15 @@ struct PeerComparison {
 
   double flipscopeFirst() const { return convertSeconds + flipscope.firstImageSeconds; }
   double givenFirst() const { return givenConvertSeconds + given.firstImageSeconds; }
+  /// The targets (issue 13), with Embree: flipscope's warm frame at most kWarmTarget times
+  /// Embree's; its convert + first image at least kSoonerTarget times sooner than Embree's build
+  /// + first frame (also with the particle spacing given).
+  static constexpr double kWarmTarget = 1.0, kSoonerTarget = 10.0;
+  double warmRatio() const { return flipscope.warmMeanMs() / embree->warmMeanMs(); }
+  double soonerRatio() const { return embree->firstFrameSeconds / flipscopeFirst(); }
+  double givenSoonerRatio() const { return embree->firstFrameSeconds / givenFirst(); }
+  static bool warmMet(double ratio) { return ratio <= kWarmTarget; }
+  static bool soonerMet(double ratio) { return ratio >= kSoonerTarget; }
   nlohmann::json json() const {
     nlohmann::json j{{"size", size},
                      {"radius_world", radiusWorld},
@@ -152,14 +162,11 @@ struct PeerComparison {
                 flipscope.warmTraceMeanMs());
     if (!embree) return;
     std::printf("  target: a warm frame no slower than Embree's: %s (%.2fx)\n",
-                flipscope.warmMeanMs() <= embree->warmMeanMs() ? "met" : "NOT met",
-                flipscope.warmMeanMs() / embree->warmMeanMs());
-    std::printf("  target: convert + first image 10x sooner than Embree's build + first frame: %s (%.1fx sooner)\n",
-                embree->firstFrameSeconds >= 10 * flipscopeFirst() ? "met" : "NOT met",
-                embree->firstFrameSeconds / flipscopeFirst());
+                warmMet(warmRatio()) ? "met" : "NOT met", warmRatio());
+    std::printf("  target: convert + first image %.0fx sooner than Embree's build + first frame: %s (%.1fx sooner)\n",
+                kSoonerTarget, soonerMet(soonerRatio()) ? "met" : "NOT met", soonerRatio());
     std::printf("  the same target with the particle spacing given, as Embree is given its radius: %s (%.1fx sooner)\n",
-                embree->firstFrameSeconds >= 10 * givenFirst() ? "met" : "NOT met",
-                embree->firstFrameSeconds / givenFirst());
+                soonerMet(givenSoonerRatio()) ? "met" : "NOT met", givenSoonerRatio());
     // flipscope's convert reads the file; Embree's build starts from particles in memory.
     const double embreeFromFile = embree->readSeconds + embree->firstFrameSeconds;
     std::printf(
@@ -212,63 +219,57 @@ PeerComparison compareWithEmbree(const fs::path& work, const fs::path& particles
   return c;
 }
 
-/// The median of `values` (the mean of the middle two for an even count); `values` not empty.
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  const std::size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
-
 /// Over the runs of the peer comparison (with Embree): each target's ratio per run, its median
 /// and range, and in how many runs it was met. On a machine whose times swing from run to run,
 /// the spread says more than one run.
 struct PeerSummary {
   struct Ratio {
-    std::vector<double> runs;
+    std::vector<double> perRun;
     int met = 0;
-    double median() const { return tools::median(runs); }
-    double min() const { return *std::min_element(runs.begin(), runs.end()); }
-    double max() const { return *std::max_element(runs.begin(), runs.end()); }
+    double median() const { return tools::median(perRun); }
+    double min() const { return *std::min_element(perRun.begin(), perRun.end()); }
+    double max() const { return *std::max_element(perRun.begin(), perRun.end()); }
+    void add(double ratio, bool metTarget) {
+      perRun.push_back(ratio);
+      met += metTarget;
+    }
     nlohmann::json json() const {
-      return {{"runs", runs}, {"median", median()}, {"min", min()}, {"max", max()}, {"met_runs", met}};
+      return {{"per_run", perRun}, {"median", median()}, {"min", min()}, {"max", max()}, {"met_runs", met}};
     }
   };
-  Ratio warm;         ///< flipscope's warm frame over Embree's (met: at most 1)
-  Ratio sooner;       ///< Embree's build + first frame over flipscope's convert + first image (met: 10)
-  Ratio givenSooner;  ///< the same with the particle spacing given
+  Ratio warm;         ///< PeerComparison::warmRatio
+  Ratio sooner;       ///< PeerComparison::soonerRatio
+  Ratio givenSooner;  ///< PeerComparison::givenSoonerRatio
 
   /// nullopt when Embree is not built in.
   static std::optional<PeerSummary> of(const std::vector<PeerComparison>& peers) {
     if (peers.empty() || !peers.front().embree) return std::nullopt;
     PeerSummary s;
     for (const PeerComparison& p : peers) {
-      const double warm = p.flipscope.warmMeanMs() / p.embree->warmMeanMs();
-      const double sooner = p.embree->firstFrameSeconds / p.flipscopeFirst();
-      const double given = p.embree->firstFrameSeconds / p.givenFirst();
-      s.warm.runs.push_back(warm);
-      s.warm.met += warm <= 1.0;
-      s.sooner.runs.push_back(sooner);
-      s.sooner.met += sooner >= 10.0;
-      s.givenSooner.runs.push_back(given);
-      s.givenSooner.met += given >= 10.0;
+      s.warm.add(p.warmRatio(), PeerComparison::warmMet(p.warmRatio()));
+      s.sooner.add(p.soonerRatio(), PeerComparison::soonerMet(p.soonerRatio()));
+      s.givenSooner.add(p.givenSoonerRatio(), PeerComparison::soonerMet(p.givenSoonerRatio()));
     }
     return s;
   }
   nlohmann::json json() const {
-    return {{"runs", warm.runs.size()},
+    return {{"runs", warm.perRun.size()},
             {"warm_frame_x_embree", warm.json()},
             {"first_image_x_sooner", sooner.json()},
             {"spacing_given_first_image_x_sooner", givenSooner.json()}};
   }
   void print() const {
-    const std::size_t n = warm.runs.size();
+    const std::size_t n = warm.perRun.size();
     std::printf("\npeer over %zu runs: median, range, runs that met the target\n", n);
-    const auto row = [n](const char* what, const Ratio& r, int decimals) {
-      std::printf("  %-62s %6.*fx %6.*fx to %.*fx %3d of %zu\n", what, decimals, r.median(), decimals, r.min(),
+    const auto row = [n](const std::string& what, const Ratio& r, int decimals) {
+      std::printf("  %-62s %6.*fx %6.*fx to %.*fx %3d of %zu\n", what.c_str(), decimals, r.median(), decimals, r.min(),
                   decimals, r.max(), r.met, n);
     };
-    row("warm frame, x Embree's (target: at most 1)", warm, 2);
-    row("convert + first image, x sooner than Embree's (target: 10)", sooner, 1);
+    char target[64];
+    std::snprintf(target, sizeof target, "(target: at most %.0f)", PeerComparison::kWarmTarget);
+    row(std::string("warm frame, x Embree's ") + target, warm, 2);
+    std::snprintf(target, sizeof target, "(target: %.0f)", PeerComparison::kSoonerTarget);
+    row(std::string("convert + first image, x sooner than Embree's ") + target, sooner, 1);
     row("the same, the particle spacing given", givenSooner, 1);
   }
 };
@@ -391,7 +392,7 @@ void runBenchRender(const BenchRenderArgs& a) {
                             {"frame_ms", r.frameMs},
                             {"trace_ms", r.traceMs}});
     if (!peers.empty()) {
-      j["peer"] = peers.front().json();
+      j["peer"] = peers.back().json();  // the run whose images the work directory holds
       for (const PeerComparison& p : peers) j["peer_runs"].push_back(p.json());
       j["peer_summary"] = peerSummary ? peerSummary->json() : nlohmann::json(nullptr);
     }
@@ -444,15 +445,17 @@ void addBenchRenderCommand(CLI::App& bench) {
       ->capture_default_str();
   cmd->add_option("--gpu-mem", args->gpuMem, "The most the brick pool may take")->capture_default_str();
   cmd->add_flag("--no-vdb-tool", args->skipVdbTool, "Skip the vdb_tool comparison");
-  cmd->add_option("--peer", args->peer,
-                  "Also render the same particles with this peer, in the same run: embree (Embree 3 sphere points, "
-                  "when built in), beside flipscope's convert and CPU ray-caster")
-      ->check(CLI::IsMember({"embree"}));
+  auto* peer =
+      cmd->add_option("--peer", args->peer,
+                      "Also render the same particles with this peer, in the same run: embree (Embree 3 sphere points, "
+                      "when built in), beside flipscope's convert and CPU ray-caster")
+          ->check(CLI::IsMember({"embree"}));
   cmd->add_option("--peer-runs", args->peerRuns,
                   "Run the peer comparison this many times, one after another, and print each target's median, "
                   "range and the runs that met it")
       ->check(CLI::Range(1, 100))
-      ->capture_default_str();
+      ->capture_default_str()
+      ->needs(peer);
   cmd->add_flag("--json", args->json, "Machine-readable output");
   cmd->callback([args] { runBenchRender(*args); });
 }

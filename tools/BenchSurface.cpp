@@ -59,6 +59,7 @@
 #include "smoothing/SurfaceNormals.h"
 #include "smoothing/SurfaceShading.h"
 #include "tools/BenchFoam.h"
+#include "tools/BenchStatistics.h"
 #include "tools/CliValues.h"
 #include "tools/Commands.h"
 #include "tools/JsonOutput.h"
@@ -276,12 +277,6 @@ GBuffer gbufferOf(const std::vector<RayHit>& hits, const RenderImage& image) {
 struct StageMs {
   double smoothing = 0, normals = 0, shading = 0;
 };
-
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  const std::size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
 
 /// Median stage times of every filter on `device` (after one warm-up run each).
 std::map<std::string, StageMs> timeStages(ScreenDevice& device, const ScreenFrame& frame, const GBuffer& gbuffer,

@@ -1,6 +1,7 @@
-// Decoding columns of fixed-size binary records (PRT, RealFlow .bin, classic bgeo): one value
-// type, byte order, offset and stride for a whole column, decoded to float in a tight loop. The
-// switch on the type runs once a column, never once a value. Private to flipscope::particles.
+// Fixed-size binary records (PRT, RealFlow .bin, classic bgeo, binary PLY, Maya PDB): read a
+// batch at a time (readRecordBatches), and decoded a column at a time: one value type, byte
+// order, offset and stride for a whole column, decoded to float in a tight loop. The switch on
+// the type runs once a column, never once a value. Private to flipscope::particles.
 #pragma once
 
 #include <algorithm>
@@ -34,13 +35,14 @@ inline void decodeVec3Column(ValueType type, ByteOrder order, const std::byte* f
   decodeColumn(type, order, first, stride, 3, count, reinterpret_cast<float*>(out));
 }
 
-/// Bytes of records a reader decodes at once: in the cache, and few reads.
+/// Bytes of records a reader reads and decodes at once: in the cache, and few reads.
 inline constexpr std::size_t kRecordBatchBytes = std::size_t(1) << 20;
 
-/// Reads `count` records of `stride` bytes from where `file` stands, kRecordBatchBytes of them
-/// (at least one record) at a time into `buffer`, and calls decode(records, n, first) for each
-/// batch of n records, the first of them record `first` of the `count`. Throws truncated(first)
-/// when the file ends inside the batch.
+/// Reads `count` records of `stride` (> 0) bytes from where `file` stands, as many as fit in
+/// kRecordBatchBytes (at least one) at a time into `buffer`, and calls decode(records, n, first)
+/// for each batch of n records, the first of them record `first` of the `count`. Leaves `file`
+/// just after the last record. Where the file ends inside record i (of the `count`), throws what
+/// truncated(i) returns, the records before i's batch decoded.
 template <class Decode, class Truncated>
 void readRecordBatches(InputFile& file, std::size_t stride, std::size_t count, std::vector<std::byte>& buffer,
                        const Decode& decode, const Truncated& truncated) {
@@ -48,7 +50,8 @@ void readRecordBatches(InputFile& file, std::size_t stride, std::size_t count, s
   for (std::size_t first = 0; first < count; first += batch) {
     const std::size_t n = std::min(batch, count - first);
     buffer.resize(n * stride);
-    if (file.read(buffer.data(), buffer.size()) != buffer.size()) throw truncated(first);
+    const std::size_t got = file.read(buffer.data(), buffer.size());
+    if (got != buffer.size()) throw truncated(first + got / stride);
     decode(buffer.data(), n, first);
   }
 }

@@ -81,9 +81,10 @@ std::unique_ptr<ParticleSource> openRealFlowParticles(InputFile file, const Read
 bool isPdb(std::span<const std::byte> head);
 std::unique_ptr<ParticleSource> openPdbParticles(InputFile file, const ReadOptions& options);
 
-/// A header's particle count that is known only at commit() (PLY's element vertex, legacy VTK's
-/// POINTS): the writer puts kCountFieldDigits zeros in its header, then this, the count in as
-/// many zero-padded decimal digits, in their place. Readers take the leading zeros as a decimal.
+/// `count` as kCountFieldDigits zero-padded decimal digits: what a writer whose header holds the
+/// particle count before the particles (PLY's element vertex, legacy VTK's POINTS) writes at
+/// commit() over the zeros it reserved there. Readers take the leading zeros as a decimal. A count
+/// of more digits is a programmer error (LogicError).
 inline constexpr std::size_t kCountFieldDigits = 15;
 inline std::string countField(std::uint64_t count) {
   std::string digits = std::to_string(count);

@@ -39,7 +39,6 @@ static_assert(std::endian::native == std::endian::little, "fields are read as st
 constexpr std::int32_t kMagic = 670;
 constexpr std::size_t kIoHeaderBytes = 6;
 constexpr std::size_t kMaxNameBytes = 1024;  ///< a longer name is damage
-constexpr std::size_t kDecodeBytes = std::size_t(1) << 20;
 /// A particle's values in one channel, at most (a larger count is damage): 256 K reals.
 constexpr std::uint32_t kMaxParticleBytes = std::uint32_t(1) << 20;
 
@@ -275,7 +274,7 @@ class PdbReader final : public ParticleSource {
   /// The values of particles [mNext, mNext + count) of `c` into `out`.
   void readChannel(const PdbChannel& c, std::size_t count, float* out) {
     const int arity = c.desc.arity;
-    const std::size_t perPiece = std::max<std::size_t>(1, kDecodeBytes / c.particleBytes);
+    const std::size_t perPiece = std::max<std::size_t>(1, kRecordBatchBytes / c.particleBytes);
     for (std::size_t done = 0; done < count;) {
       const std::size_t particles = std::min(perPiece, count - done);
       const std::uint64_t at = c.offset + (mNext + done) * c.particleBytes;

@@ -15,6 +15,7 @@
 
 #include "core/AtomicFile.h"
 #include "core/Error.h"
+#include "preprocess/particles/BinaryColumns.h"
 #include "preprocess/particles/InputFile.h"
 #include "preprocess/particles/ParticleFormats.h"
 
@@ -23,8 +24,6 @@ namespace {
 
 constexpr std::size_t kMaxHeaderBytes = 1 << 20;
 constexpr std::size_t kMaxLineBytes = 1 << 16;
-/// Binary records are read this many bytes at a time: a slice that stays in the cache.
-constexpr std::size_t kBinarySliceBytes = 1 << 20;
 
 enum class PlyType { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64 };
 
@@ -354,28 +353,26 @@ class PlyReader final : public ParticleSource {
                                        std::to_string(mHeader.vertexBytes) + " bytes a vertex)");
   }
 
-  /// Binary records in one read of kBinarySliceBytes (at least one).
-  std::size_t recordsPerSlice() const { return std::max<std::size_t>(1, kBinarySliceBytes / mHeader.vertexBytes); }
+  /// Binary records in one read of kRecordBatchBytes (at least one).
+  std::size_t recordsPerSlice() const { return std::max<std::size_t>(1, kRecordBatchBytes / mHeader.vertexBytes); }
 
-  /// A megabyte of records at a time (kBinarySliceBytes): the reader holds that, not a chunk's
+  /// A megabyte of records at a time (readRecordBatches): the reader holds that, not a chunk's
   /// records (24 MB for a million particles of six floats), and the split reads them from the cache.
   void readBinary(ParticleChunk& chunk, std::uint64_t n) {
     const std::size_t stride = mHeader.vertexBytes;
-    const std::size_t slice = recordsPerSlice();
-    for (std::uint64_t done = 0; done < n; done += slice) {
-      const std::size_t count = std::size_t(std::min<std::uint64_t>(slice, n - done));
-      mBuffer.resize(count * stride);
-      const std::size_t got = mFile.read(mBuffer.data(), mBuffer.size());
-      if (got != mBuffer.size()) throw truncated(mNext + done + got / stride);
-      splitRecords(mBuffer.data(), count, chunk.positions.data() + done,
-                   mHasVelocity ? chunk.velocities.data() + done : nullptr);
-      for (std::size_t a = 0; a < mSelected.size(); ++a) {
-        const std::size_t offset = mHeader.vertexProperties[mSelected[a]].offset;
-        const BinaryDecoder decode = mSelectedDecoders[a];
-        float* out = chunk.attributes[a].values.data() + done;
-        for (std::size_t k = 0; k < count; ++k) out[k] = decode(mBuffer.data() + k * stride + offset);
-      }
-    }
+    readRecordBatches(
+        mFile, stride, std::size_t(n), mBuffer,
+        [&](const std::byte* records, std::size_t count, std::size_t done) {
+          splitRecords(records, count, chunk.positions.data() + done,
+                       mHasVelocity ? chunk.velocities.data() + done : nullptr);
+          for (std::size_t a = 0; a < mSelected.size(); ++a) {
+            const std::size_t offset = mHeader.vertexProperties[mSelected[a]].offset;
+            const BinaryDecoder decode = mSelectedDecoders[a];
+            float* out = chunk.attributes[a].values.data() + done;
+            for (std::size_t k = 0; k < count; ++k) out[k] = decode(records + k * stride + offset);
+          }
+        },
+        [&](std::size_t inside) { return truncated(mNext + inside); });
   }
 
   /// The positions (and, where `velocities` is given, the velocities) of `n` binary records

@@ -150,8 +150,8 @@ class RealFlowReader final : public ParticleSource {
                          chunk.attributes[k].values.data() + begin * std::size_t(c.arity));
           }
         },
-        [&](std::size_t begin) {
-          return fail("the file ends inside particle " + std::to_string(mNext + begin) + " of " +
+        [&](std::size_t inside) {
+          return fail("the file ends inside particle " + std::to_string(mNext + inside) + " of " +
                       std::to_string(mCount) + " (was it truncated while being read?)");
         });
     mNext += n;

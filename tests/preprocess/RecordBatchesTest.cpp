@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "preprocess/particles/BinaryColumns.h"
+#include "preprocess/particles/InputFile.h"
 
 namespace flipscope {
 namespace {
@@ -27,9 +28,10 @@ struct Batch {
   std::size_t first, count;
 };
 
-TEST(RecordBatches, EveryRecordComesOnceInOrderInBatchesOfTheBatchBytes) {
+TEST(RecordBatches, EveryRecordComesOnceInOrderInBatchesOfTheBatchBytesAndTheFileStandsAfterThem) {
   const std::size_t stride = kRecordBatchBytes / 3 + 5;  // two records a batch
-  const std::vector<std::byte> bytes = records(7, stride);
+  std::vector<std::byte> bytes = records(7, stride);
+  bytes.resize(bytes.size() + 9, std::byte(0xee));  // what follows the records stays unread
   InputFile file("records.bin", bytes);
   std::vector<std::byte> buffer, seen;
   std::vector<Batch> batches;
@@ -45,7 +47,18 @@ TEST(RecordBatches, EveryRecordComesOnceInOrderInBatchesOfTheBatchBytes) {
     EXPECT_EQ(batches[b].first, 2 * b);
     EXPECT_EQ(batches[b].count, b < 3 ? 2u : 1u);
   }
-  EXPECT_EQ(seen, bytes);
+  EXPECT_EQ(seen, std::vector<std::byte>(bytes.begin(), bytes.begin() + std::ptrdiff_t(7 * stride)));
+  EXPECT_EQ(file.offset(), 7 * stride);
+}
+
+TEST(RecordBatches, NoRecordsReadNothing) {
+  const std::vector<std::byte> bytes = records(2, 12);
+  InputFile file("records.bin", bytes);
+  std::vector<std::byte> buffer;
+  readRecordBatches(
+      file, 12, 0, buffer, [](const std::byte*, std::size_t, std::size_t) { FAIL() << "a batch of no records"; },
+      [](std::size_t first) { return std::runtime_error("truncated at " + std::to_string(first)); });
+  EXPECT_EQ(file.offset(), 0u);
 }
 
 TEST(RecordBatches, RecordsLargerThanABatchComeOneAtATime) {
@@ -66,7 +79,7 @@ TEST(RecordBatches, RecordsLargerThanABatchComeOneAtATime) {
   EXPECT_EQ(seen, bytes);
 }
 
-TEST(RecordBatches, AFileThatEndsInsideABatchThrowsWithThatBatchsFirstRecord) {
+TEST(RecordBatches, AFileThatEndsInsideARecordThrowsWithThatRecordAfterTheBatchesBefore) {
   const std::size_t stride = kRecordBatchBytes / 3 + 5;
   std::vector<std::byte> bytes = records(7, stride);
   bytes.resize(5 * stride + 1);  // ends inside record 5, in the batch of records 4 and 5
@@ -80,7 +93,7 @@ TEST(RecordBatches, AFileThatEndsInsideABatchThrowsWithThatBatchsFirstRecord) {
         [](std::size_t first) { return std::runtime_error("truncated at " + std::to_string(first)); });
     FAIL() << "a truncated file was read";
   } catch (const std::runtime_error& e) {
-    EXPECT_EQ(std::string(e.what()), "truncated at 4");
+    EXPECT_EQ(std::string(e.what()), "truncated at 5");
   }
   EXPECT_EQ(decoded, (std::vector<std::size_t>{0, 2}));
 }

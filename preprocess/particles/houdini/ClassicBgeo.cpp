@@ -198,8 +198,8 @@ class ClassicBgeoReader final : public ParticleSource {
                          chunk.attributes[k].values.data() + begin * std::size_t(a.size));
           }
         },
-        [&](std::size_t begin) {
-          return FileError(mFile.path(), "the file ends inside point " + std::to_string(mNext + begin) + " of " +
+        [&](std::size_t inside) {
+          return FileError(mFile.path(), "the file ends inside point " + std::to_string(mNext + inside) + " of " +
                                              std::to_string(total) + " (was it truncated while being read?)");
         });
     mNext += n;
@@ -307,31 +307,35 @@ class ClassicBgeoReader final : public ParticleSource {
 
   /// The point indices of a particle primitive's vertices (each followed by vertex values).
   void checkVertexIndices(std::uint64_t vertices, std::uint64_t vertexBytes, std::int64_t primitive) {
-    const std::size_t stride = std::size_t(vertexBytes);
-    const std::size_t batch = std::max<std::size_t>(1, (std::size_t(1) << 20) / stride);
     const bool wide = mHeader.points > 0xffff;
-    for (std::uint64_t begin = 0; begin < vertices; begin += batch) {
-      const std::size_t count = std::size_t(std::min<std::uint64_t>(batch, vertices - begin));
-      mBuffer.resize(count * stride);
-      mFile.readExact(mBuffer.data(), mBuffer.size(), "a particle primitive's vertices");
-      for (std::size_t v = 0; v < count; ++v) {
-        const std::byte* p = mBuffer.data() + v * stride;
-        std::uint32_t index;
-        if (wide) {
-          std::memcpy(&index, p, 4);
-          index = __builtin_bswap32(index);
-        } else {
-          std::uint16_t narrow;
-          std::memcpy(&narrow, p, 2);
-          index = __builtin_bswap16(narrow);
-        }
-        if (index >= std::uint64_t(mHeader.points))
-          throw FileError(mFile.path(), "classic bgeo: vertex " + std::to_string(begin + v) +
-                                            " of particle primitive " + std::to_string(primitive) +
-                                            " refers to point " + std::to_string(index) + " of " +
-                                            std::to_string(mHeader.points));
-      }
-    }
+    const std::uint64_t at = mFile.offset();
+    readRecordBatches(
+        mFile, std::size_t(vertexBytes), std::size_t(vertices), mBuffer,
+        [&](const std::byte* records, std::size_t count, std::size_t first) {
+          for (std::size_t v = 0; v < count; ++v) {
+            const std::byte* p = records + v * std::size_t(vertexBytes);
+            std::uint32_t index;
+            if (wide) {
+              std::memcpy(&index, p, 4);
+              index = __builtin_bswap32(index);
+            } else {
+              std::uint16_t narrow;
+              std::memcpy(&narrow, p, 2);
+              index = __builtin_bswap16(narrow);
+            }
+            if (index >= std::uint64_t(mHeader.points))
+              throw FileError(mFile.path(), "classic bgeo: vertex " + std::to_string(first + v) +
+                                                " of particle primitive " + std::to_string(primitive) +
+                                                " refers to point " + std::to_string(index) + " of " +
+                                                std::to_string(mHeader.points));
+          }
+        },
+        [&](std::size_t inside) {
+          return FileError(mFile.path(), "truncated: the file ends inside vertex " + std::to_string(inside) +
+                                             " of particle primitive " + std::to_string(primitive) + " (at byte " +
+                                             std::to_string(at + inside * vertexBytes) + ", file size " +
+                                             std::to_string(mFile.size()) + ")");
+        });
   }
 
   /// The file holds `what`, which this reader does not walk: it must still end with 0xff.
