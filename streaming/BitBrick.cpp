@@ -157,7 +157,23 @@ BrickCells makeBrickCells(const DecodedBrick& brick, const ConversionOptions& op
   std::int64_t previous = -1;
   std::size_t keptCells = 0;
   bool anyFoam = false;
-  for (std::size_t i = 0; i < brick.cells.size(); ++i) {
+  if (!kinds) {
+    // Every cell kept, none foam (stores without kinds): the same loop without the kinds' tests
+    // took 13 % less time a 64^3 brick at 25 % fill (`bench streaming`, 0.046 against 0.053 ms;
+    // with the word's update in a lambda shared by both loops, no gain).
+    for (const std::uint32_t cell : brick.cells) {
+      FLIPSCOPE_CHECK(std::int64_t(cell) > previous, "cells not ascending: " << cell << " after " << previous);
+      previous = cell;
+      if ((cell >> 6) != wordIndex) {
+        out.bits[wordIndex] = word;
+        word = 0;
+        wordIndex = cell >> 6;
+      }
+      word |= std::uint64_t(1) << (cell & 63);
+    }
+    keptCells = brick.cells.size();
+  }
+  for (std::size_t i = 0; kinds && i < brick.cells.size(); ++i) {
     const std::uint32_t cell = brick.cells[i];
     FLIPSCOPE_CHECK(std::int64_t(cell) > previous, "cells not ascending: " << cell << " after " << previous);
     previous = cell;
