@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <bit>
 #include <string>
+#include <type_traits>
 
 #include "core/Error.h"
 
@@ -152,45 +153,39 @@ BrickCells makeBrickCells(const DecodedBrick& brick, const ConversionOptions& op
   if (options.foamKinds && kinds) out.foamKinds.assign(out.bits.size(), 0);
   if (!brick.cells.empty())
     FLIPSCOPE_CHECK(brick.cells.back() < cellsPerBrick, "last cell " << brick.cells.back() << " >= " << cellsPerBrick);
-  // Cells ascend: gather each word in a register and store it once.
-  std::uint64_t word = 0, wordIndex = 0;
-  std::int64_t previous = -1;
+  // Cells ascend: gather each word in a register and store it once. One loop, made twice: with
+  // the kinds' tests, and without them for stores without kinds (13 % less time a 64^3 brick at
+  // 25 % fill than the loop with the tests: `bench streaming`, 0.046 against 0.053 ms).
   std::size_t keptCells = 0;
   bool anyFoam = false;
-  if (!kinds) {
-    // Every cell kept, none foam (stores without kinds): the same loop without the kinds' tests
-    // took 13 % less time a 64^3 brick at 25 % fill (`bench streaming`, 0.046 against 0.053 ms;
-    // with the word's update in a lambda shared by both loops, no gain).
-    for (const std::uint32_t cell : brick.cells) {
+  const auto setCells = [&](auto withKinds) {
+    std::uint64_t word = 0, wordIndex = 0;
+    std::int64_t previous = -1;
+    for (std::size_t i = 0; i < brick.cells.size(); ++i) {
+      const std::uint32_t cell = brick.cells[i];
       FLIPSCOPE_CHECK(std::int64_t(cell) > previous, "cells not ascending: " << cell << " after " << previous);
       previous = cell;
+      if constexpr (withKinds)
+        if (hidden(i)) continue;
+      ++keptCells;
       if ((cell >> 6) != wordIndex) {
         out.bits[wordIndex] = word;
         word = 0;
         wordIndex = cell >> 6;
       }
       word |= std::uint64_t(1) << (cell & 63);
+      if constexpr (withKinds)
+        if (!out.foamKinds.empty() && foam(i)) {
+          out.foamKinds[cell >> 6] |= std::uint64_t(1) << (cell & 63);
+          anyFoam = true;
+        }
     }
-    keptCells = brick.cells.size();
-  }
-  for (std::size_t i = 0; kinds && i < brick.cells.size(); ++i) {
-    const std::uint32_t cell = brick.cells[i];
-    FLIPSCOPE_CHECK(std::int64_t(cell) > previous, "cells not ascending: " << cell << " after " << previous);
-    previous = cell;
-    if (hidden(i)) continue;
-    ++keptCells;
-    if ((cell >> 6) != wordIndex) {
-      out.bits[wordIndex] = word;
-      word = 0;
-      wordIndex = cell >> 6;
-    }
-    word |= std::uint64_t(1) << (cell & 63);
-    if (!out.foamKinds.empty() && foam(i)) {
-      out.foamKinds[cell >> 6] |= std::uint64_t(1) << (cell & 63);
-      anyFoam = true;
-    }
-  }
-  out.bits[wordIndex] |= word;
+    out.bits[wordIndex] |= word;
+  };
+  if (kinds)
+    setCells(std::true_type{});
+  else
+    setCells(std::false_type{});
   if (!anyFoam) std::vector<std::uint64_t>().swap(out.foamKinds);  // no foam: nothing to assemble
   if (options.attribute == AttributeReduction::None) return out;
 
