@@ -54,6 +54,16 @@ KeyGrid::KeyGrid(const StoreHeader& h, std::optional<Box> clipBox)
   }
 }
 
+static_assert(kParticleKindCount == 4, "a batch key keeps a particle's kind in two bits");
+
+std::uint64_t KeyGrid::batchKeyBits() const {
+  const std::uint64_t cellKey = (std::uint64_t(1) << (cellBits + codeBits)) - 1;
+  const std::uint64_t kindBits = std::uint64_t(kParticleKindCount - 1);
+  const bool kinds = header.particleKinds;
+  if (valueInKey) return ((cellKey | (kinds ? kindBits << kPackedCellBits : 0)) << 32) | 0xffffffffull;
+  return cellKey | (kinds ? kindBits << kKindShift : 0);
+}
+
 namespace {
 
 /// Keys a block holds at least (splitBlocksByBrick): 512 KiB, which with its copy sorted by

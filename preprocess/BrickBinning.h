@@ -55,6 +55,9 @@ struct KeyGrid {
   bool valuesBesideKeys() const { return attribute() && !valueInKey; }
   /// Where a batch key's cell key starts: 32 when valueInKey, else 0.
   std::uint32_t cellKeyShift() const { return valueInKey ? 32 : 0; }
+  /// The bits a batch key of this grid may set (KeyBatch's layouts): its cell key's, the
+  /// value's where it lies in the key, and the kind's in stores with particle kinds.
+  std::uint64_t batchKeyBits() const;
 };
 
 /// Bits of a cell key below the kind (ParticleKind in bits 48-49 of stores with kinds).

@@ -24,10 +24,10 @@
 #include "core/Error.h"
 #include "core/NumberText.h"
 #include "preprocess/BrickBinning.h"
-#include "preprocess/DirectFile.h"
 #include "preprocess/FiniteBounds.h"
 #include "preprocess/ParticleSpacing.h"
 #include "preprocess/PositionRanges.h"
+#include "preprocess/SpillBuckets.h"
 #include "preprocess/particles/PrefetchingSource.h"
 #include "preprocess/store/FrameFile.h"
 #include "preprocess/store/StoreLock.h"
@@ -37,6 +37,7 @@ namespace {
 
 using detail::KeyBatch;
 using detail::KeyGrid;
+using detail::SpillBuckets;
 
 /// Spill files are `<kSpillPrefix><pid>-<frame>[-<n>]-<bucket>`.
 constexpr std::string_view kSpillPrefix = ".flipscope-spill-";
@@ -92,170 +93,6 @@ struct MemoryPlan {
   std::uint64_t maxBucketFiles;   ///< spill files open at once
   std::uint64_t spillBufferBytes;  ///< buffer of each, a multiple of kDirectBlock
   std::uint64_t readAheadBytes;    ///< of the input, by its binning pass
-};
-
-/// Spill record: the batch key (KeyBatch), then the attribute value when it travels beside it.
-std::size_t recordBytes(bool values) { return values ? 12 : 8; }
-
-/// Bucket files of one partition level: bucket b holds the batch keys whose digit
-/// (key >> shift) & (count - 1) is b, with their values when `values`. Written and read as
-/// DirectFiles, in blocks: a bucket's last block is padded, its record count says where its
-/// records end. Files are removed on destruction.
-class SpillBuckets {
- public:
-  SpillBuckets(const std::filesystem::path& dir, const std::string& prefix, std::uint32_t shift, std::uint32_t bits,
-               bool values, std::size_t bufferBytes)
-      : mShift(shift),
-        mBits(bits),
-        mValues(values),
-        mBufferBytes(bufferBytes),
-        mAppender(std::make_unique<detail::BackgroundAppender>(bufferBytes, kQueuedBlocks)) {
-    const std::size_t count = std::size_t(1) << bits;
-    for (std::size_t b = 0; b < count; ++b) {
-      Bucket bucket;
-      bucket.path = dir / (prefix + "-" + std::to_string(b));
-      mBuckets.push_back(std::move(bucket));
-    }
-  }
-  ~SpillBuckets() {
-    mAppender.reset();  // first: its queued writes name the files
-    for (auto& b : mBuckets) {
-      b.file.reset();
-      std::error_code ec;
-      std::filesystem::remove(b.path, ec);
-      b.cleanup.release();
-    }
-  }
-  SpillBuckets(const SpillBuckets&) = delete;
-  SpillBuckets& operator=(const SpillBuckets&) = delete;
-
-  void add(const std::uint64_t* keys, const float* values, std::size_t n) {
-    const std::uint64_t mask = (1ull << mBits) - 1;
-    const std::size_t bytes = recordBytes(mValues);
-    for (std::size_t i = 0; i < n; ++i) {
-      Bucket& b = mBuckets[(keys[i] >> mShift) & mask];
-      if (b.buffer.size() == 0) b.buffer = mAppender->take();
-      std::byte* record = b.buffer.data() + b.used;
-      std::memcpy(record, &keys[i], 8);
-      if (mValues) std::memcpy(record + 8, &values[i], 4);
-      b.used += bytes;
-      ++b.records;
-      if (b.used + bytes > b.buffer.size()) flush(b, false);
-    }
-  }
-  void finish() {
-    for (auto& b : mBuckets) flush(b, true);
-    mAppender->drain();
-    for (auto& b : mBuckets) b.file.reset();
-  }
-  std::size_t size() const { return mBuckets.size(); }
-  std::uint64_t records(std::size_t b) const { return mBuckets[b].records; }
-  std::uint32_t shift() const { return mShift; }
-
-  /// Streams bucket b (after finish()) in pieces:
-  /// fn(const uint64_t* keys, const float* values, size_t n); values is null without them.
-  template <class Fn>
-  void forEachPiece(std::size_t b, Fn&& fn) const {
-    const Bucket& bucket = mBuckets[b];
-    if (!bucket.records) return;
-    detail::DirectFile file(bucket.path, detail::DirectFile::Mode::Read);
-    const std::size_t bytes = recordBytes(mValues);
-    AlignedBuffer block(4 * mBufferBytes);  // the spill buffers are free by now (finish())
-    std::vector<std::uint64_t> keys;
-    std::vector<float> values;
-    std::byte carry[16];  // a record split across two blocks
-    std::size_t carried = 0;
-    for (std::uint64_t done = 0; done < bucket.records;) {
-      const std::size_t got = file.read({block.data(), block.size()});
-      if (got == 0) throw FileError(bucket.path, "spill file shorter than written");
-      keys.clear();
-      values.clear();
-      std::size_t at = 0;
-      auto take = [&](const std::byte* record) {
-        std::uint64_t key;
-        std::memcpy(&key, record, 8);
-        keys.push_back(key);
-        if (mValues) {
-          float value;
-          std::memcpy(&value, record + 8, 4);
-          values.push_back(value);
-        }
-        ++done;
-      };
-      if (!mValues) {  // the records are the keys: handed over where they lie (8-byte records never straddle)
-        const std::size_t n = std::min<std::uint64_t>(got / 8, bucket.records - done);
-        done += n;
-        fn(reinterpret_cast<const std::uint64_t*>(block.data()), nullptr, n);
-        continue;
-      }
-      if (carried) {
-        at = std::min(bytes - carried, got);
-        std::memcpy(carry + carried, block.data(), at);
-        carried += at;
-        if (carried == bytes) {
-          take(carry);
-          carried = 0;
-        }
-      }
-      for (; at + bytes <= got && done < bucket.records; at += bytes) take(block.data() + at);
-      if (done < bucket.records && at < got) {
-        carried = got - at;
-        std::memcpy(carry, block.data() + at, carried);
-      }
-      fn(keys.data(), mValues ? values.data() : nullptr, keys.size());
-    }
-  }
-
-  /// Loads bucket b (after finish()) into `batch`.
-  void load(std::size_t b, KeyBatch& batch) const {
-    batch.clear();
-    forEachPiece(b, [&](const std::uint64_t* k, const float* s, std::size_t n) {
-      batch.cellKeys.insert(batch.cellKeys.end(), k, k + n);
-      if (s) batch.values.insert(batch.values.end(), s, s + n);
-    });
-  }
-
- private:
-  struct Bucket {
-    std::filesystem::path path;
-    std::unique_ptr<detail::DirectFile> file;
-    AlignedBuffer buffer;          ///< allocated at the bucket's first record
-    std::size_t used = 0;          ///< bytes of buffer not yet written
-    std::uint64_t records = 0;
-    CleanupOnSignal cleanup;  ///< from before the file exists until it is removed
-  };
-  /// Queues the buffer's whole blocks for writing; at the end (`last`), all of it, its last
-  /// block padded. What is left moves to a buffer of its own.
-  void flush(Bucket& b, bool last) {
-    const std::size_t whole =
-        last ? (b.used + kDirectBlock - 1) / kDirectBlock * kDirectBlock : b.used / kDirectBlock * kDirectBlock;
-    if (whole == 0) return;
-    if (!b.file) {
-      const DeferCleanupSignals step;  // registered and created as one step
-      b.cleanup = CleanupOnSignal(b.path);
-      b.file = std::make_unique<detail::DirectFile>(b.path, detail::DirectFile::Mode::Create);
-    }
-    if (whole > b.used) std::memset(b.buffer.data() + b.used, 0, whole - b.used);
-    AlignedBuffer rest;
-    const std::size_t left = last ? 0 : b.used - whole;
-    if (!last) {
-      rest = mAppender->take();
-      std::memcpy(rest.data(), b.buffer.data() + whole, left);
-    }
-    mAppender->append(*b.file, std::move(b.buffer), whole);
-    b.buffer = std::move(rest);
-    b.used = left;
-    stopPoint("spill");
-  }
-
-  /// Blocks being written at once: the disk works while the binning computes.
-  static constexpr std::size_t kQueuedBlocks = 4;
-
-  std::uint32_t mShift, mBits;
-  bool mValues;
-  std::size_t mBufferBytes;
-  std::vector<Bucket> mBuckets;
-  std::unique_ptr<detail::BackgroundAppender> mAppender;
 };
 
 /// Bins one frame's keys: in memory while they fit, spilled to buckets beyond.
@@ -339,7 +176,8 @@ class FrameBinner {
   void startSpilling() {
     const std::uint32_t bits = bucketBitsFor(mGrid.codeBits);
     const std::uint32_t shift = mGrid.cellKeyShift() + mGrid.cellBits + mGrid.codeBits - bits;
-    mSpill = std::make_unique<SpillBuckets>(mScratch, mPrefix, shift, bits, mValues, mPlan.spillBufferBytes);
+    mSpill = std::make_unique<SpillBuckets>(mScratch, mPrefix, mGrid.batchKeyBits(), shift, bits, mValues,
+                                            mPlan.spillBufferBytes);
     mSpill->add(mKeys.cellKeys.data(), mKeys.values.data(), mKeys.cellKeys.size());
     mKeys.clear();
     std::vector<detail::CodedRun>().swap(mKeys.runs);  // the buckets loaded into mKeys have none
@@ -391,8 +229,8 @@ class FrameBinner {
         throw InputError("a single brick holds " + std::to_string(buckets.records(b)) +
                          " particles, more than --mem allows binning at once; raise --mem or use a smaller cell size");
       const std::uint32_t bits = bucketBitsFor(remaining);
-      SpillBuckets sub(mScratch, mPrefix + "-" + std::to_string(mSpillBuckets), buckets.shift() - bits, bits, mValues,
-                       mPlan.spillBufferBytes);
+      SpillBuckets sub(mScratch, mPrefix + "-" + std::to_string(mSpillBuckets), mGrid.batchKeyBits(),
+                       buckets.shift() - bits, bits, mValues, mPlan.spillBufferBytes);
       mSpillBuckets += std::uint32_t(sub.size());
       buckets.forEachPiece(b, [&](const std::uint64_t* k, const float* s, std::size_t n) { sub.add(k, s, n); });
       sub.finish();
