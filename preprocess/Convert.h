@@ -50,7 +50,7 @@
 // written), chunk (a chunk of particles read), spill (a spill file written to), brick (a brick
 // appended to the frame's temporary, on the thread that appends it), frame-file (the frame file
 // committed, not listed yet), frame (listed in store.fsh); and, through testStopPoint, the
-// commands' own points around a convert: render-store (`render` of particle files: the store it
+// commands' own points around a convert (ConvertStopPoint.h): render-store (`render` of particle files: the store it
 // converted registered for removal, before it renders).
 #pragma once
 
@@ -62,9 +62,10 @@
 
 #include "core/Box.h"
 #include "core/Progress.h"
-#include "preprocess/store/BrickStore.h"
+#include "preprocess/ConvertStopPoint.h"  // testStopPoint, the hook above, for a command's own points
 #include "preprocess/particles/InputSequence.h"
 #include "preprocess/particles/ParticleSource.h"
+#include "preprocess/store/BrickStore.h"
 
 namespace flipscope {
 
@@ -143,9 +144,6 @@ struct ConvertReport {
   /// Worth telling the user (e.g. a fallback from one cell per particle spacing).
   std::vector<std::string> warnings;
 };
-
-/// The test hook above at `point`, for a command's own points around a convert.
-void testStopPoint(const char* point);
 
 /// Converts every frame of `inputs` into the store at `storeDir` (created, or appended to:
 /// then its domain and cell size are kept). Throws InputError/FileError.

@@ -7,7 +7,7 @@
 #include <ios>
 
 #include "core/Error.h"
-#include "preprocess/Convert.h"
+#include "preprocess/ConvertStopPoint.h"
 
 namespace flipscope::detail {
 
@@ -16,8 +16,9 @@ static_assert(std::endian::native == std::endian::little, "a record keeps the lo
 SpillRecordLayout::SpillRecordLayout(std::uint64_t keyBits, std::uint32_t digitShift, std::uint32_t digitBits,
                                      bool values)
     : mKeyBits(keyBits), mDigitShift(digitShift), mValues(values) {
-  FLIPSCOPE_CHECK(digitBits < 64 && digitShift + digitBits <= 64, "digit " << digitShift << "+" << digitBits);
-  const std::uint64_t digit = digitBits == 0 ? 0 : (~std::uint64_t(0) >> (64 - digitBits)) << digitShift;
+  FLIPSCOPE_CHECK(digitBits >= 1 && digitBits < 64 && digitShift + digitBits <= 64,
+                  "digit " << digitShift << "+" << digitBits);
+  const std::uint64_t digit = (~std::uint64_t(0) >> (64 - digitBits)) << digitShift;
   std::uint64_t kept = keyBits & ~digit;
   std::uint32_t to = 0;
   while (kept) {
@@ -106,14 +107,14 @@ void SpillBuckets::flush(Bucket& b, bool last) {
 }
 
 template <class Fn>
-void SpillBuckets::forEachRecord(std::size_t b, Fn&& fn, const std::function<void()>& blockDone) const {
+void SpillBuckets::forEachRecord(std::size_t b, Fn&& fn) const {
   const Bucket& bucket = mBuckets[b];
   if (!bucket.records) return;
   DirectFile file(bucket.path, DirectFile::Mode::Read);
   const std::size_t bytes = mLayout.recordBytes(), keyBytes = mLayout.keyBytes();
   const bool withValues = mLayout.values();
-  AlignedBuffer block(4 * mBufferBytes);     // the spill buffers are free by now (finish())
-  std::byte carry[2 * kRecordWriteBytes]{};  // a record split across two blocks, and 8 bytes to read beyond it
+  AlignedBuffer block(4 * mBufferBytes);  // the spill buffers are free by now (finish())
+  std::byte carry[kRecordWriteBytes]{};   // a record split across two blocks (take reads its first 12 bytes)
   std::size_t carried = 0;
   std::uint64_t done = 0;
   // The record at `record`, of which at least 8 + 4 bytes may be read.
@@ -148,25 +149,26 @@ void SpillBuckets::forEachRecord(std::size_t b, Fn&& fn, const std::function<voi
       carried = got - at;
       std::memcpy(carry, block.data() + at, carried);
     }
-    if (blockDone) blockDone();
   }
 }
 
 void SpillBuckets::forEachPiece(std::size_t b, const PieceFn& fn) const {
+  const bool withValues = mLayout.values();
   std::vector<std::uint64_t> keys;
   std::vector<float> values;
-  const bool withValues = mLayout.values();
-  forEachRecord(
-      b,
-      [&](std::uint64_t key, float value) {
-        keys.push_back(key);
-        if (withValues) values.push_back(value);
-      },
-      [&] {
-        fn(keys.data(), withValues ? values.data() : nullptr, keys.size());
-        keys.clear();
-        values.clear();
-      });
+  keys.reserve(kPieceKeys);
+  if (withValues) values.reserve(kPieceKeys);
+  const auto hand = [&] {
+    fn(keys.data(), withValues ? values.data() : nullptr, keys.size());
+    keys.clear();
+    values.clear();
+  };
+  forEachRecord(b, [&](std::uint64_t key, float value) {
+    keys.push_back(key);
+    if (withValues) values.push_back(value);
+    if (keys.size() == kPieceKeys) hand();
+  });
+  if (!keys.empty()) hand();
 }
 
 void SpillBuckets::load(std::size_t b, KeyBatch& batch) const {

@@ -4,10 +4,11 @@
 // (key >> shift) & (2^bits - 1) is b, with their attribute values when they travel beside the keys.
 //
 // Contract:
-// - A record keeps only the key's bits that vary within its bucket (SpillRecordLayout): those a
-//   key of the grid may set, less the bucket's digit. On the grids of `bench preprocess` that is
-//   3 bytes a particle instead of 8; the spill files are written once and read once, so on a
-//   machine whose disk bounds the out-of-core convert, fewer bytes are the speed-up.
+// - A record keeps the key's bits that a key of the grid may set, less its bucket's digit
+//   (SpillRecordLayout). On the grid of `bench preprocess` that is 3 bytes a particle instead of
+//   8; the spill files are written once and read once, so on a machine whose disk bounds the
+//   out-of-core convert, fewer bytes are the speed-up. (A sub-bucket's records, of a bucket split
+//   again, keep its parent's digit too: rare, and not worth a layout of their own.)
 // - A bucket's records are in the order they were added.
 // - Files are DirectFiles written in blocks from buffers of `bufferBytes` (one a bucket that
 //   holds records, plus kQueuedBlocks being written); a bucket's last block is padded, its
@@ -94,7 +95,8 @@ class SpillBuckets {
 
   /// One piece of a bucket: n keys, and their values (null without them), valid during the call.
   using PieceFn = std::function<void(const std::uint64_t* keys, const float* values, std::size_t n)>;
-  /// Streams bucket b (after finish()) in pieces, in the order its records were added.
+  /// Streams bucket b (after finish()) in pieces of at most kPieceKeys keys, in the order its
+  /// records were added.
   void forEachPiece(std::size_t b, const PieceFn& fn) const;
   /// Loads bucket b (after finish()) into `batch`.
   void load(std::size_t b, KeyBatch& batch) const;
@@ -108,10 +110,9 @@ class SpillBuckets {
     std::uint64_t records = 0;
     CleanupOnSignal cleanup;  ///< from before the file exists until it is removed
   };
-  /// Calls fn(key, value) for each record of bucket b (value 0 without values), in order, and
-  /// blockDone (when given) after each block read.
+  /// Calls fn(key, value) for each record of bucket b (value 0 without values), in order.
   template <class Fn>
-  void forEachRecord(std::size_t b, Fn&& fn, const std::function<void()>& blockDone = {}) const;
+  void forEachRecord(std::size_t b, Fn&& fn) const;
   /// Queues the buffer's whole blocks for writing; at the end (`last`), all of it, its last
   /// block padded. What is left moves to a buffer of its own.
   void flush(Bucket& b, bool last);
@@ -120,6 +121,8 @@ class SpillBuckets {
   static constexpr std::size_t kQueuedBlocks = 4;
   /// Bytes a record's store may touch: the key's 8 (whatever its record keeps) and a value's 4.
   static constexpr std::size_t kRecordWriteBytes = 12;
+  /// Keys of forEachPiece's pieces at most (768 KiB with their values).
+  static constexpr std::size_t kPieceKeys = std::size_t(1) << 16;
 
   std::uint32_t mShift, mBits;
   SpillRecordLayout mLayout;

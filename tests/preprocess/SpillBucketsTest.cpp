@@ -1,8 +1,11 @@
-// SpillBuckets: a record keeps only the key bits that vary within its bucket, and every bucket
-// reads back the keys (and values) added to it, in order, whatever the record size and however
-// records straddle the blocks read.
+// SpillBuckets: a record keeps the bits a key of its grid may set, less its bucket's digit; the
+// keys computeKeys makes set no others; and every bucket reads back the keys (and values) added
+// to it, in order, whatever the record size, however records straddle the blocks read, for a
+// digit at the top of the brick code or below it (a bucket split again), and for empty buckets.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -28,8 +31,10 @@ StoreHeader headerOf(std::uint32_t bricksPerAxis, AttributeKind attribute, bool 
   return h;
 }
 
-/// A random key a grid may make: random bits within its batch key bits.
-std::uint64_t randomKey(std::mt19937_64& random, std::uint64_t keyBits) { return random() & keyBits; }
+/// Where the digit of `bits` bits at the top of the grid's brick codes starts.
+std::uint32_t topDigitShift(const KeyGrid& grid, std::uint32_t bits) {
+  return grid.cellKeyShift() + grid.cellBits + grid.codeBits - bits;
+}
 
 struct LayoutCase {
   const char* name;
@@ -41,17 +46,16 @@ struct LayoutCase {
 
 class SpillRecordLayoutOfGrid : public ::testing::TestWithParam<LayoutCase> {};
 
-TEST_P(SpillRecordLayoutOfGrid, KeepsTheBitsThatVaryWithinABucketAndRoundTripsEveryKey) {
+TEST_P(SpillRecordLayoutOfGrid, KeepsTheGridsBitsLessTheDigitAndRoundTripsEveryKey) {
   const LayoutCase c = GetParam();
   const KeyGrid grid(headerOf(c.bricksPerAxis, c.attribute, c.kinds));
-  const std::uint32_t bits = 8;
-  const std::uint32_t shift = grid.cellKeyShift() + grid.cellBits + grid.codeBits - bits;
+  const std::uint32_t bits = 8, shift = topDigitShift(grid, bits);
   const SpillRecordLayout layout(grid.batchKeyBits(), shift, bits, grid.valuesBesideKeys());
   EXPECT_EQ(layout.keyBytes(), c.keyBytes);
   EXPECT_EQ(layout.recordBytes(), c.keyBytes + (grid.valuesBesideKeys() ? 4 : 0));
   std::mt19937_64 random(7);
   for (int i = 0; i < 100000; ++i) {
-    const std::uint64_t key = randomKey(random, grid.batchKeyBits());
+    const std::uint64_t key = random() & grid.batchKeyBits();
     ASSERT_TRUE(layout.holds(key));
     const std::uint64_t digit = (key >> shift) & 0xff;
     const std::uint64_t packed = layout.pack(key);
@@ -60,9 +64,8 @@ TEST_P(SpillRecordLayoutOfGrid, KeepsTheBitsThatVaryWithinABucketAndRoundTripsEv
     const std::uint64_t above = layout.keyBytes() == 8 ? 0 : random() << (8 * layout.keyBytes());
     ASSERT_EQ(layout.unpack(packed | above, digit), key) << std::hex << key;
   }
-  if (~grid.batchKeyBits() != 0) {
-    EXPECT_FALSE(layout.holds(~grid.batchKeyBits()));
-  }
+  ASSERT_NE(~grid.batchKeyBits(), 0u);
+  EXPECT_FALSE(layout.holds(~grid.batchKeyBits()));
 }
 
 // Cell keys: 18 bits of the cell in its 64^3 brick and 3 a level of the brick octree.
@@ -72,18 +75,50 @@ INSTANTIATE_TEST_SUITE_P(
                       LayoutCase{"PlainWithKinds", 8, AttributeKind::None, true, 3},        // + 2 kind bits = 21
                       LayoutCase{"ValueInKey", 8, AttributeKind::Speed, false, 7},          // + a 32-bit value = 51
                       LayoutCase{"ValueInKeyWithKinds", 8, AttributeKind::Speed, true, 7},  // 53
-                      LayoutCase{"ValueBesideKey", 256, AttributeKind::Speed, false,
-                                 5},  // 18 + 24 - 8 = 34 bits, + 4 bytes
-                      LayoutCase{"ValueBesideKeyWithKinds", 256, AttributeKind::Speed, true, 5}),  // 36 bits
+                      LayoutCase{"ValueBesideKey", 256, AttributeKind::Speed, false, 5},    // 18 + 24 - 8 = 34
+                      LayoutCase{"ValueBesideKeyWithKinds", 256, AttributeKind::Speed, true, 5}),  // 36
     [](const auto& info) { return std::string(info.param.name); });
 
-/// Adds `keys` (and `values`) to buckets in chunks of uneven sizes, then checks every bucket
-/// reads back, by forEachPiece and by load, the keys of its digit in the order added.
-void checkRoundTrip(const KeyGrid& grid, std::uint32_t bits, const std::vector<std::uint64_t>& keys,
-                    const std::vector<float>& values, std::size_t bufferBytes) {
+TEST(SpillRecordLayout, HoldsEveryKeyComputeKeysMakes) {
+  // The grid's corners, every kind, speeds from 0 to the largest float and NaN: each key sets
+  // only bits of batchKeyBits(), or a record would lose some.
+  for (const StoreHeader& header :
+       {headerOf(8, AttributeKind::None, false), headerOf(8, AttributeKind::None, true),
+        headerOf(8, AttributeKind::Speed, false), headerOf(8, AttributeKind::Speed, true),
+        headerOf(256, AttributeKind::Speed, false), headerOf(256, AttributeKind::Speed, true)}) {
+    const KeyGrid grid(header);
+    const float last = float(glm::vec3(grid.cells).x) - 0.5f;  // the centre of the grid's last cell
+    ParticleChunk chunk;
+    AttributeColumn types{"U", 1, {}};
+    const float speeds[] = {0.0f, 1.0f, std::numeric_limits<float>::max(), std::numeric_limits<float>::quiet_NaN()};
+    const float flags[] = {0.0f, 2.0f, 4.0f, 8.0f};  // liquid, spray, bubble, foam
+    for (const glm::vec3 p : {glm::vec3(0.5f), glm::vec3(last), glm::vec3(last, 0.5f, last)})
+      for (float speed : speeds)
+        for (float flag : flags) {
+          chunk.positions.push_back(p);
+          chunk.velocities.push_back(glm::vec3(speed, 0.0f, 0.0f));
+          types.values.push_back(flag);
+        }
+    detail::KeyBatch batch;
+    const detail::KeyTally tally = detail::computeKeys(chunk, grid, batch, header.particleKinds ? &types : nullptr);
+    ASSERT_EQ(tally.kept, chunk.size());
+    std::uint64_t set = 0;
+    for (std::uint64_t key : batch.cellKeys) set |= key;
+    EXPECT_EQ(set & ~grid.batchKeyBits(), 0u) << std::hex << set << " against " << grid.batchKeyBits();
+    // And the kind bits are set where the store keeps kinds (a bubble is 3).
+    if (header.particleKinds) {
+      EXPECT_NE(set & (grid.valueInKey ? 3ull << 62 : 3ull << 48), 0u);
+    }
+  }
+}
+
+/// Adds `keys` (and `values`) to buckets of the digit [shift, shift + bits) in chunks of uneven
+/// sizes, then checks every bucket reads back, by forEachPiece and by load, the keys of its digit
+/// in the order added.
+void checkRoundTrip(const KeyGrid& grid, std::uint32_t shift, std::uint32_t bits,
+                    const std::vector<std::uint64_t>& keys, const std::vector<float>& values, std::size_t bufferBytes) {
   testing::TempDir dir("spill-buckets");
   const bool withValues = grid.valuesBesideKeys();
-  const std::uint32_t shift = grid.cellKeyShift() + grid.cellBits + grid.codeBits - bits;
   SpillBuckets buckets(dir.path(), "spill", grid.batchKeyBits(), shift, bits, withValues, bufferBytes);
   for (std::size_t at = 0, chunk = 1; at < keys.size(); at += chunk, chunk = chunk * 3 % 9973 + 1) {
     const std::size_t n = std::min(chunk, keys.size() - at);
@@ -106,6 +141,7 @@ void checkRoundTrip(const KeyGrid& grid, std::uint32_t bits, const std::vector<s
     std::vector<float> streamedValues;
     buckets.forEachPiece(b, [&](const std::uint64_t* k, const float* s, std::size_t n) {
       ASSERT_EQ(s != nullptr, withValues);
+      ASSERT_GT(n, 0u);
       streamed.insert(streamed.end(), k, k + n);
       if (s) streamedValues.insert(streamedValues.end(), s, s + n);
     });
@@ -113,38 +149,66 @@ void checkRoundTrip(const KeyGrid& grid, std::uint32_t bits, const std::vector<s
     ASSERT_EQ(streamedValues, expectedValues) << "bucket " << b;
     detail::KeyBatch batch;
     buckets.load(b, batch);
-    ASSERT_TRUE(std::equal(batch.cellKeys.begin(), batch.cellKeys.end(), expectedKeys.begin(), expectedKeys.end()))
-        << "bucket " << b;
-    ASSERT_TRUE(std::equal(batch.values.begin(), batch.values.end(), expectedValues.begin(), expectedValues.end()))
-        << "bucket " << b;
+    ASSERT_EQ(std::vector<std::uint64_t>(batch.cellKeys.begin(), batch.cellKeys.end()), expectedKeys) << "bucket " << b;
+    ASSERT_EQ(std::vector<float>(batch.values.begin(), batch.values.end()), expectedValues) << "bucket " << b;
   }
   EXPECT_EQ(total, keys.size());
 }
 
+/// Buffers of 11 blocks: buckets are read 44 blocks at a time, which records of 3, 7 and 10
+/// bytes straddle (8-byte ones cannot).
+constexpr std::size_t kBufferBytes = 11 * kDirectBlock;
+
 TEST(SpillBuckets, EveryBucketReadsBackItsKeysInOrderForEveryRecordSize) {
-  // Records of 3, 7, 7 and 5 + 4 bytes: most straddle the blocks they are read in; buffers of
-  // three blocks, so that a bucket's records go out in many writes.
   std::mt19937_64 random(11);
-  for (const StoreHeader& header :
-       {headerOf(8, AttributeKind::None, false), headerOf(8, AttributeKind::Speed, false),
-        headerOf(8, AttributeKind::Speed, true), headerOf(256, AttributeKind::Speed, true)}) {
-    const KeyGrid grid(header);
-    std::vector<std::uint64_t> keys(150000);
+  struct Case {
+    StoreHeader header;
+    std::size_t recordBytes;  ///< with a digit of 3 bits at the top of the brick code
+  };
+  for (const Case& c : {Case{headerOf(8, AttributeKind::None, false), 3},           // 27 - 3 = 24 bits
+                        Case{headerOf(8, AttributeKind::Speed, false), 7},          // 59 - 3 = 56 bits
+                        Case{headerOf(8, AttributeKind::Speed, true), 8},           // 61 - 3 = 58 bits
+                        Case{headerOf(256, AttributeKind::Speed, true), 6 + 4}}) {  // 44 - 3 = 41 bits, a value
+    const KeyGrid grid(c.header);
+    const std::uint32_t bits = 3, shift = topDigitShift(grid, bits);
+    SCOPED_TRACE(::testing::Message() << "key bits " << std::hex << grid.batchKeyBits());
+    ASSERT_EQ(SpillRecordLayout(grid.batchKeyBits(), shift, bits, grid.valuesBesideKeys()).recordBytes(),
+              c.recordBytes);
+    if (c.recordBytes != 8) {
+      ASSERT_NE(4 * kBufferBytes % c.recordBytes, 0u);  // records straddle blocks
+    }
+    // Enough keys that each bucket spans several blocks.
+    std::vector<std::uint64_t> keys(600000);
     std::vector<float> values(keys.size());
     for (std::size_t i = 0; i < keys.size(); ++i) {
-      keys[i] = randomKey(random, grid.batchKeyBits());
+      keys[i] = random() & grid.batchKeyBits();
       values[i] = float(i) * 0.25f - 7.0f;
     }
-    SCOPED_TRACE(::testing::Message() << "key bits " << std::hex << grid.batchKeyBits());
-    checkRoundTrip(grid, 3, keys, values, 3 * kDirectBlock);
+    checkRoundTrip(grid, shift, bits, keys, values, kBufferBytes);
   }
+}
+
+TEST(SpillBuckets, ABucketSplitAgainAndEmptyBucketsReadBack) {
+  // FrameBinner's skewed path: the keys of one top bucket (the same 8-bit digit) go to buckets of
+  // the 3 bits below it, one of which (5) gets none.
+  std::mt19937_64 random(13);
+  const KeyGrid grid(headerOf(256, AttributeKind::Speed, true));
+  const std::uint32_t top = topDigitShift(grid, 8), shift = top - 3;
+  std::vector<std::uint64_t> keys;
+  std::vector<float> values;
+  while (keys.size() < 200000) {
+    std::uint64_t key = (random() & grid.batchKeyBits() & ~(0xffull << top)) | (0xa5ull << top);
+    if (((key >> shift) & 7) == 5) continue;
+    keys.push_back(key);
+    values.push_back(float(keys.size()));
+  }
+  checkRoundTrip(grid, shift, 3, keys, values, kBufferBytes);
 }
 
 TEST(SpillBuckets, AKeyWithBitsTheGridCannotSetIsRefused) {
   testing::TempDir dir("spill-buckets-refused");
   const KeyGrid grid(headerOf(8, AttributeKind::None, false));
-  const std::uint32_t shift = grid.cellBits + grid.codeBits - 2;
-  SpillBuckets buckets(dir.path(), "spill", grid.batchKeyBits(), shift, 2, false, 3 * kDirectBlock);
+  SpillBuckets buckets(dir.path(), "spill", grid.batchKeyBits(), topDigitShift(grid, 2), 2, false, kBufferBytes);
   const std::uint64_t key = grid.batchKeyBits() + 1;  // the lowest bit above the cell key
   EXPECT_THROW(buckets.add(&key, nullptr, 1), LogicError);
 }
