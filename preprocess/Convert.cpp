@@ -149,11 +149,13 @@ class FrameBinner {
       binInMemory(mKeys, writer);
     } else {
       mSpill->finish();
+      mSpillBytes += mSpill->bytesWritten();
       binBuckets(*mSpill, writer);
     }
     return mStats;
   }
   std::uint32_t spillBuckets() const { return mSpillBuckets; }
+  std::uint64_t spillBytes() const { return mSpillBytes; }
 
  private:
   void account(const detail::KeyTally& t) {
@@ -234,6 +236,7 @@ class FrameBinner {
       mSpillBuckets += std::uint32_t(sub.size());
       buckets.forEachPiece(b, [&](const std::uint64_t* k, const float* s, std::size_t n) { sub.add(k, s, n); });
       sub.finish();
+      mSpillBytes += sub.bytesWritten();
       binBuckets(sub, writer);
     }
   }
@@ -265,6 +268,7 @@ class FrameBinner {
   KeyBatch mBatch;     // one chunk, once spilling
   std::unique_ptr<SpillBuckets> mSpill;
   std::uint32_t mSpillBuckets = 0;
+  std::uint64_t mSpillBytes = 0;  // of every level's spill files
 };
 
 std::unique_ptr<ParticleSource> joined(std::vector<std::unique_ptr<ParticleSource>> parts) {
@@ -820,6 +824,7 @@ FrameReport convertOneFrame(ParticleSource& source, BrickStore& store, int frame
   report.bricks = std::uint32_t(index.bricks.size());
   report.storeBytes = index.fileBytes;
   report.spillBuckets = binner.spillBuckets();
+  report.spillBytes = binner.spillBytes();
   report.seconds = secondsSince(start);
   return report;
 }

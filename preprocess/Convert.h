@@ -129,6 +129,7 @@ struct FrameReport {
   std::uint64_t storeBytes = 0;
   double seconds = 0;
   std::uint32_t spillBuckets = 0;  ///< 0 when the frame was binned in core
+  std::uint64_t spillBytes = 0;    ///< written to its spill files (SpillBuckets::bytesWritten)
 };
 
 struct ConvertReport {

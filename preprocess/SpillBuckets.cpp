@@ -101,6 +101,7 @@ void SpillBuckets::flush(Bucket& b, bool last) {
     std::memcpy(rest.data(), b.buffer.data() + whole, left);
   }
   mAppender->append(*b.file, std::move(b.buffer), whole);
+  mBytesWritten += whole;
   b.buffer = std::move(rest);
   b.used = left;
   testStopPoint("spill");

@@ -92,6 +92,8 @@ class SpillBuckets {
   std::uint64_t records(std::size_t b) const { return mBuckets[b].records; }
   std::uint32_t shift() const { return mShift; }
   const SpillRecordLayout& layout() const { return mLayout; }
+  /// Bytes written to the files so far: their records, each file's last block padded.
+  std::uint64_t bytesWritten() const { return mBytesWritten; }
 
   /// One piece of a bucket: n keys, and their values (null without them), valid during the call.
   using PieceFn = std::function<void(const std::uint64_t* keys, const float* values, std::size_t n)>;
@@ -127,6 +129,7 @@ class SpillBuckets {
   std::uint32_t mShift, mBits;
   SpillRecordLayout mLayout;
   std::size_t mBufferBytes;
+  std::uint64_t mBytesWritten = 0;
   std::vector<Bucket> mBuckets;
   std::unique_ptr<BackgroundAppender> mAppender;
 };

@@ -84,9 +84,12 @@ void runConvert(const ConvertArgs& a) {
     std::printf("particle spacing unknown (%s)\n", report.spacingOrigin.c_str());
   std::printf("up axis %s (%s)\n", std::string(upAxisName(h.upAxis)).c_str(), report.upAxisOrigin.c_str());
   for (const auto& f : report.frames) {
-    std::printf("  frame %d: %llu particles, %u bricks, %s bytes, %.2f s%s", f.frame,
+    std::printf("  frame %d: %llu particles, %u bricks, %s bytes, %.2f s", f.frame,
                 (unsigned long long)f.stats.particles, f.bricks, Progress::humanCount(double(f.storeBytes)).c_str(),
-                f.seconds, f.spillBuckets ? " (out of core)" : "");
+                f.seconds);
+    if (f.spillBuckets)
+      std::printf(" (out of core: %s bytes spilled to %u buckets)", Progress::humanCount(double(f.spillBytes)).c_str(),
+                  f.spillBuckets);
     if (h.attribute != AttributeKind::None && f.stats.particles > 0)
       std::printf("; %s %g to %g", h.attributeName.c_str(), f.stats.attributeMin, f.stats.attributeMax);
     if (h.particleKinds) std::printf("; cells %s", describeKindCells(f.stats.kindCells).c_str());

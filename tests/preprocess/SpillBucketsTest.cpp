@@ -126,6 +126,10 @@ void checkRoundTrip(const KeyGrid& grid, std::uint32_t shift, std::uint32_t bits
   }
   buckets.finish();
   ASSERT_EQ(buckets.size(), std::size_t(1) << bits);
+  std::uint64_t written = 0;  // each bucket's records, its last block padded
+  for (std::size_t b = 0; b < buckets.size(); ++b)
+    written += (buckets.records(b) * buckets.layout().recordBytes() + kDirectBlock - 1) / kDirectBlock * kDirectBlock;
+  EXPECT_EQ(buckets.bytesWritten(), written);
   std::uint64_t total = 0;
   for (std::size_t b = 0; b < buckets.size(); ++b) {
     std::vector<std::uint64_t> expectedKeys;

@@ -44,7 +44,7 @@ TEST_P(ConvertMemory, PeakStaysWithinTheBudgetPlusTheFixedOverhead) {
   const auto run =
       testing::runFlipscope("convert " + input + " -o store --mem " + std::to_string(kBudgetMiB) + "M", dir.path());
   ASSERT_EQ(run.exitCode, 0) << run.output;
-  EXPECT_NE(run.output.find("(out of core)"), std::string::npos)
+  EXPECT_NE(run.output.find("(out of core: "), std::string::npos)
       << "5 M particles should not fit the budget: " << run.output;
   const double peak = peakMiB(run.output);
   ASSERT_GT(peak, 0) << run.output;
