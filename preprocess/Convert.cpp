@@ -186,40 +186,53 @@ class FrameBinner {
     mSpillBuckets += std::uint32_t(mSpill->size());
   }
 
-  void binBuckets(const SpillBuckets& buckets, FrameWriter& writer) {
+  /// Bins each bucket in turn. Each bucket's file is removed once read, on a thread of its own
+  /// (an unlink waits on the disk), and all of them before this returns: before the frame's fsync,
+  /// which then need not flush the spill's blocks from the disk's cache where the filesystem
+  /// discards a removed file's blocks.
+  void binBuckets(SpillBuckets& buckets, FrameWriter& writer) {
     std::uint64_t largest = 0;  // of the buckets binned in memory: reserved once, no reallocation copies
     bool skewed = false;        // some bucket must be split again
     for (std::size_t b = 0; b < buckets.size(); ++b) {
       if (buckets.records(b) <= mPlan.maxBinParticles) largest = std::max(largest, buckets.records(b));
       skewed = skewed || buckets.records(b) > mPlan.maxBinParticles;
     }
-    // The next bucket is read while this one is binned, when two of the largest fit one bin of the
-    // budget and no bucket is split again (its bins would use both batches).
+    // The next bucket's records are read while this one is binned (on a thread that waits on the
+    // disk; they are unpacked on every core at their turn), when two of the largest buckets' keys
+    // fit one bin of the budget (the records take no more) and no bucket is split again.
     const bool ahead = mOptions.readAhead && !skewed && 2 * largest <= mPlan.maxBinParticles;
     mKeys.cellKeys.reserve(largest);
     if (mValues) mKeys.values.reserve(largest);
-    if (ahead) {
-      mNextKeys.cellKeys.reserve(largest);
-      if (mValues) mNextKeys.values.reserve(largest);
-    }
-    std::future<void> reading;                // of bucket `readBucket` into mNextKeys
+    if (ahead && mNextRecords.size() < buckets.recordBufferBytes(largest))
+      mNextRecords = AlignedBuffer(buckets.recordBufferBytes(largest));
+    std::future<void> removing;  // of the file of the last bucket read
+    const auto removeRead = [&](std::size_t b) {
+      if (removing.valid()) removing.get();
+      removing = std::async(std::launch::async, [&buckets, b] { buckets.remove(b); });
+    };
+    std::future<void> reading;                // of bucket `readBucket`'s records into mNextRecords
     std::size_t readBucket = buckets.size();  // none
     for (std::size_t b = 0; b < buckets.size(); ++b) {
       if (buckets.records(b) == 0) continue;
       if (buckets.records(b) <= mPlan.maxBinParticles) {
-        if (readBucket == b) {
-          reading.get();
-          std::swap(mKeys, mNextKeys);
-        } else {
+        if (!ahead) {
           buckets.load(b, mKeys);
+        } else {
+          if (readBucket == b)
+            reading.get();
+          else  // the first
+            buckets.readRecords(b, mNextRecords);
+          buckets.unpack(b, mNextRecords, mKeys);
         }
+        removeRead(b);
         readBucket = buckets.size();
         if (ahead) {
           std::size_t next = b + 1;
           while (next < buckets.size() && buckets.records(next) == 0) ++next;
           if (next < buckets.size()) {
             readBucket = next;
-            reading = std::async(std::launch::async, [&buckets, this, next] { buckets.load(next, mNextKeys); });
+            reading =
+                std::async(std::launch::async, [&buckets, this, next] { buckets.readRecords(next, mNextRecords); });
           }
         }
         binInMemory(mKeys, writer);
@@ -235,10 +248,12 @@ class FrameBinner {
                        buckets.shift() - bits, bits, mValues, mPlan.spillBufferBytes);
       mSpillBuckets += std::uint32_t(sub.size());
       buckets.forEachPiece(b, [&](const std::uint64_t* k, const float* s, std::size_t n) { sub.add(k, s, n); });
+      removeRead(b);
       sub.finish();
       mSpillBytes += sub.bytesWritten();
       binBuckets(sub, writer);
     }
+    if (removing.valid()) removing.get();
   }
 
   /// Bins `batch` into `writer` (the batch is empty after).
@@ -264,7 +279,7 @@ class FrameBinner {
   bool mHasRange = false;
   KeyBatch& mKeys;     // in memory until spilling starts; then each bucket in turn
   bool mReserved = false;  // mKeys reserved for the frame
-  KeyBatch mNextKeys;  // the bucket after, read while mKeys is binned
+  AlignedBuffer mNextRecords;  // the records of the bucket after, read while mKeys is binned
   KeyBatch mBatch;     // one chunk, once spilling
   std::unique_ptr<SpillBuckets> mSpill;
   std::uint32_t mSpillBuckets = 0;

@@ -6,6 +6,9 @@
 #include <cstring>
 #include <ios>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "core/Error.h"
 #include "preprocess/ConvertStopPoint.h"
 
@@ -51,12 +54,19 @@ SpillBuckets::SpillBuckets(const std::filesystem::path& dir, const std::string& 
 
 SpillBuckets::~SpillBuckets() {
   mAppender.reset();  // first: its queued writes name the files
-  for (auto& b : mBuckets) {
-    b.file.reset();
+  for (std::size_t b = 0; b < mBuckets.size(); ++b) remove(b);
+}
+
+void SpillBuckets::remove(std::size_t b) noexcept {
+  Bucket& bucket = mBuckets[b];
+  if (bucket.removed) return;
+  bucket.removed = true;
+  bucket.file.reset();
+  if (bucket.records) {  // a bucket without records never had a file
     std::error_code ec;
-    std::filesystem::remove(b.path, ec);
-    b.cleanup.release();
+    std::filesystem::remove(bucket.path, ec);
   }
+  bucket.cleanup.release();
 }
 
 void SpillBuckets::add(const std::uint64_t* keys, const float* values, std::size_t n) {
@@ -111,6 +121,7 @@ template <class Fn>
 void SpillBuckets::forEachRecord(std::size_t b, Fn&& fn) const {
   const Bucket& bucket = mBuckets[b];
   if (!bucket.records) return;
+  FLIPSCOPE_CHECK(!bucket.removed, "spill bucket " << b << " read after its removal");
   DirectFile file(bucket.path, DirectFile::Mode::Read);
   const std::size_t bytes = mLayout.recordBytes(), keyBytes = mLayout.keyBytes();
   const bool withValues = mLayout.values();
@@ -184,6 +195,44 @@ void SpillBuckets::load(std::size_t b, KeyBatch& batch) const {
     keys[i] = key;
     if (withValues) values[i] = value;
     ++i;
+  });
+}
+
+std::size_t SpillBuckets::recordBufferBytes(std::uint64_t records) const {
+  // The file's blocks, and one more: unpack reads kRecordWriteBytes from the last record on.
+  return (records * mLayout.recordBytes() + kDirectBlock - 1) / kDirectBlock * kDirectBlock + kDirectBlock;
+}
+
+void SpillBuckets::readRecords(std::size_t b, AlignedBuffer& raw) const {
+  const Bucket& bucket = mBuckets[b];
+  FLIPSCOPE_CHECK(!bucket.removed, "spill bucket " << b << " read after its removal");
+  const std::size_t bytes = recordBufferBytes(bucket.records);
+  if (raw.size() < bytes) raw = AlignedBuffer(bytes);
+  if (!bucket.records) return;
+  DirectFile file(bucket.path, DirectFile::Mode::Read);
+  const std::size_t fileBytes = bytes - kDirectBlock;
+  if (file.read({raw.data(), fileBytes}) != fileBytes) throw FileError(bucket.path, "spill file shorter than written");
+}
+
+void SpillBuckets::unpack(std::size_t b, const AlignedBuffer& raw, KeyBatch& batch) const {
+  const std::uint64_t records = mBuckets[b].records;
+  FLIPSCOPE_CHECK(raw.size() >= recordBufferBytes(records), "spill bucket " << b << " in " << raw.size() << " bytes");
+  batch.clear();
+  const bool withValues = mLayout.values();
+  batch.cellKeys.resize(records);
+  if (withValues) batch.values.resize(records);
+  std::uint64_t* keys = batch.cellKeys.data();
+  float* values = batch.values.data();
+  const std::size_t bytes = mLayout.recordBytes(), keyBytes = mLayout.keyBytes();
+  const std::byte* data = raw.data();
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, records, std::size_t(1) << 16), [&](const auto& range) {
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      const std::byte* record = data + i * bytes;
+      std::uint64_t packed;
+      std::memcpy(&packed, record, 8);
+      keys[i] = mLayout.unpack(packed, b);
+      if (withValues) std::memcpy(&values[i], record + keyBytes, 4);
+    }
   });
 }
 

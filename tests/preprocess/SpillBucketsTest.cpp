@@ -1,10 +1,12 @@
 // SpillBuckets: a record keeps the bits a key of its grid may set, less its bucket's digit; the
 // keys computeKeys makes set no others; and every bucket reads back the keys (and values) added
 // to it, in order, whatever the record size, however records straddle the blocks read, for a
-// digit at the top of the brick code or below it (a bucket split again), and for empty buckets.
+// digit at the top of the brick code or below it (a bucket split again), and for empty buckets;
+// a bucket's file is removed once read.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <limits>
 #include <random>
 #include <vector>
@@ -113,8 +115,8 @@ TEST(SpillRecordLayout, HoldsEveryKeyComputeKeysMakes) {
 }
 
 /// Adds `keys` (and `values`) to buckets of the digit [shift, shift + bits) in chunks of uneven
-/// sizes, then checks every bucket reads back, by forEachPiece and by load, the keys of its digit
-/// in the order added.
+/// sizes, then checks every bucket reads back, by forEachPiece, by load and by readRecords and
+/// unpack, the keys of its digit in the order added.
 void checkRoundTrip(const KeyGrid& grid, std::uint32_t shift, std::uint32_t bits,
                     const std::vector<std::uint64_t>& keys, const std::vector<float>& values, std::size_t bufferBytes) {
   testing::TempDir dir("spill-buckets");
@@ -131,6 +133,7 @@ void checkRoundTrip(const KeyGrid& grid, std::uint32_t shift, std::uint32_t bits
     written += (buckets.records(b) * buckets.layout().recordBytes() + kDirectBlock - 1) / kDirectBlock * kDirectBlock;
   EXPECT_EQ(buckets.bytesWritten(), written);
   std::uint64_t total = 0;
+  AlignedBuffer raw;
   for (std::size_t b = 0; b < buckets.size(); ++b) {
     std::vector<std::uint64_t> expectedKeys;
     std::vector<float> expectedValues;
@@ -155,8 +158,23 @@ void checkRoundTrip(const KeyGrid& grid, std::uint32_t shift, std::uint32_t bits
     buckets.load(b, batch);
     ASSERT_EQ(std::vector<std::uint64_t>(batch.cellKeys.begin(), batch.cellKeys.end()), expectedKeys) << "bucket " << b;
     ASSERT_EQ(std::vector<float>(batch.values.begin(), batch.values.end()), expectedValues) << "bucket " << b;
+    // In one read, then unpacked, into a buffer kept from bucket to bucket (grown, or larger).
+    buckets.readRecords(b, raw);
+    EXPECT_GE(raw.size(), buckets.recordBufferBytes(buckets.records(b)));
+    detail::KeyBatch unpacked;
+    buckets.unpack(b, raw, unpacked);
+    ASSERT_EQ(std::vector<std::uint64_t>(unpacked.cellKeys.begin(), unpacked.cellKeys.end()), expectedKeys)
+        << "bucket " << b;
+    ASSERT_EQ(std::vector<float>(unpacked.values.begin(), unpacked.values.end()), expectedValues) << "bucket " << b;
+    // Read, the bucket's file goes; an empty bucket never had one.
+    const std::filesystem::path file = dir.path() / ("spill-" + std::to_string(b));
+    EXPECT_EQ(std::filesystem::exists(file), buckets.records(b) > 0) << "bucket " << b;
+    buckets.remove(b);
+    EXPECT_FALSE(std::filesystem::exists(file)) << "bucket " << b;
+    EXPECT_EQ(buckets.records(b), expectedKeys.size()) << "bucket " << b;
   }
   EXPECT_EQ(total, keys.size());
+  EXPECT_TRUE(std::filesystem::is_empty(dir.path()));  // before the buckets' destruction
 }
 
 /// Buffers of 11 blocks: buckets are read 44 blocks at a time, which records of 3, 7 and 10

@@ -255,6 +255,16 @@ TEST_F(ConvertInterrupt, SigkillAtEveryStageLeavesCompleteFramesOrAnIncompleteSt
 
 TEST_F(ConvertInterrupt, SigintAtEveryStageLeavesNoTemporaryOrSpillFile) { stopEverywhere(SIGINT); }
 
+TEST_F(ConvertInterrupt, AnOutOfCoreFramesSpillFilesAreGoneWhenItsFileIsCommitted) {
+  // Each bucket's file is removed once read (SpillBuckets::remove): killed the moment frame 2's
+  // file is committed, its convert leaves no spill file.
+  const fs::path store = dir / "committed";
+  const int status = convertStopped(store, "frame-file:2:KILL");
+  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << readText(dir / "log");
+  EXPECT_TRUE(fs::exists(store / "frame_000002.fsf"));
+  for (const auto& name : namesIn(store)) EXPECT_NE(name.rfind(".flipscope-spill-", 0), 0u) << name;
+}
+
 TEST_F(ConvertInterrupt, SignalsAfterIncreasingDelays) {
   const auto t0 = std::chrono::steady_clock::now();
   ASSERT_EQ(convertStopped(dir / "timing", ""), 0) << readText(dir / "log");
