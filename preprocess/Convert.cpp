@@ -198,9 +198,11 @@ class FrameBinner {
       skewed = skewed || buckets.records(b) > mPlan.maxBinParticles;
     }
     // The next bucket's records are read while this one is binned (on a thread that waits on the
-    // disk; they are unpacked on every core at their turn), when two of the largest buckets' keys
-    // fit one bin of the budget (the records take no more) and no bucket is split again.
-    const bool ahead = mOptions.readAhead && !skewed && 2 * largest <= mPlan.maxBinParticles;
+    // disk; they are unpacked on every core at their turn), when the largest bucket's keys and
+    // records fit one bin of the budget and no bucket is split again.
+    const std::uint64_t keyBytes = mValues ? 12 : 8;  // a key and its value (MemoryPlan)
+    const bool ahead = mOptions.readAhead && !skewed &&
+                       largest * keyBytes + buckets.recordBufferBytes(largest) <= mPlan.maxBinParticles * keyBytes;
     mKeys.cellKeys.reserve(largest);
     if (mValues) mKeys.values.reserve(largest);
     if (ahead && mNextRecords.size() < buckets.recordBufferBytes(largest))
@@ -224,7 +226,6 @@ class FrameBinner {
             buckets.readRecords(b, mNextRecords);
           buckets.unpack(b, mNextRecords, mKeys);
         }
-        removeRead(b);
         readBucket = buckets.size();
         if (ahead) {
           std::size_t next = b + 1;
@@ -235,6 +236,7 @@ class FrameBinner {
                 std::async(std::launch::async, [&buckets, this, next] { buckets.readRecords(next, mNextRecords); });
           }
         }
+        removeRead(b);  // once the next read is on its way: this waits for the removal before
         binInMemory(mKeys, writer);
         continue;
       }

@@ -107,8 +107,8 @@ struct ConvertOptions {
   int zstdLevel = 1;
   /// Read the next chunk of particles on a thread of its own while this one is binned (and
   /// while the bounds and the spacing passes work on it): PrefetchingSource; out of core, also
-  /// the next spill bucket while this one is binned. Off: one thread reads and bins in turn.
-  /// The store is the same either way.
+  /// the next spill bucket while this one is binned. Off: one thread reads and bins in turn
+  /// (spill files are still removed on threads of their own). The store is the same either way.
   bool readAhead = true;
   std::filesystem::path scratchDir;    ///< spill files; default: the store directory
   /// Add to the store at storeDir, which must exist, with its header: also a store with no

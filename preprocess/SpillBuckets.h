@@ -86,7 +86,8 @@ class SpillBuckets {
   /// Throws FileError (disk full, I/O error); a key with bits outside keyBits is a programmer
   /// error (checked).
   void add(const std::uint64_t* keys, const float* values, std::size_t n);
-  /// Writes what the buffers hold and closes the files; then forEachPiece() and load() read them.
+  /// Writes what the buffers hold and closes the files; then forEachPiece(), load() and
+  /// readRecords() read them.
   void finish();
 
   std::size_t size() const { return mBuckets.size(); }
@@ -113,7 +114,8 @@ class SpillBuckets {
   /// every core.
   void unpack(std::size_t b, const AlignedBuffer& raw, KeyBatch& batch) const;
   /// Removes bucket b's file, once it was read: it is read no more (records(b) still counts
-  /// it). May run on one thread while others read other buckets. An unlink waits on the disk:
+  /// it). May run on one thread while others read other buckets (not bucket b, nor beside the
+  /// destructor). An unlink waits on the disk:
   /// the 256 files of a 100 M particle frame (300 MB) took 0.2 s on the development VM, whose
   /// ext4 is mounted with `discard`; there, files removed before the frame's fsync spare it from
   /// flushing their blocks out of the disk's cache (0.23 s, against 5 ms).
