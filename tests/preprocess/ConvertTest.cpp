@@ -245,6 +245,12 @@ TEST_P(ConvertOutOfCore, StoreIsByteIdenticalToInCoreWithAndWithoutReadAhead) {
   const auto [aheadDir, aheadReport] = run(16ull << 20, "ooc-read-ahead");
   EXPECT_GT(aheadReport.spillBuckets, 1u);
   EXPECT_EQ(readFile(aheadDir / "frame_000001.fsf"), readFile(inCore / "frame_000001.fsf"));
+  // So they are under 24 MiB, also where the values travel beside the keys (12 bytes a particle),
+  // which under 16 MiB are read in turn (a mutation of SpillBuckets::unpack fails all four cases
+  // here, only three of them under 16 MiB).
+  const auto [ahead24Dir, ahead24Report] = run(24ull << 20, "ooc-read-ahead-24");
+  EXPECT_GT(ahead24Report.spillBuckets, 1u);
+  EXPECT_EQ(readFile(ahead24Dir / "frame_000001.fsf"), readFile(inCore / "frame_000001.fsf"));
   // A source that gives its count spills from its first chunk; one that does not is binned in
   // memory until it overflows, then spills what it holds.
   const auto [unhinted, unhintedReport] = run(4ull << 20, "ooc-no-count", true, false);
