@@ -72,13 +72,13 @@ struct MemoryPlan {
   explicit MemoryPlan(std::uint64_t budget, bool separateValues) {
     // Key (+ value): binning sorts in place. Its runs (at most 24 bytes a detail::kKeysPerRun
     // keys: 5.6 % of the budget at most) and its per-thread blocks fit in what keys leave.
-    const std::uint64_t perParticle = separateValues ? 12 : 8;
+    keyBytes = separateValues ? 12 : 8;
     // At most 256 Ki particles a chunk (6 MiB of positions and velocities; two chunks are in
     // flight with read-ahead): the 20 M particle PLY of `bench render --peer embree` converted in
     // 0.67-0.70 s with chunks of 256 Ki, 0.69-0.71 s with 512 Ki, 0.70-1.00 s with 1 Mi (their
     // first touch) and 0.69-0.76 s with 64 Ki (the passes a chunk), alternating runs.
     chunkParticles = std::clamp<std::uint64_t>(budget / 256 / 24, 4096, 1 << 18);
-    maxBinParticles = std::max<std::uint64_t>(budget * 6 / 10 / perParticle, 1 << 16);
+    maxBinParticles = std::max<std::uint64_t>(budget * 6 / 10 / keyBytes, 1 << 16);
     // An eighth of the budget buffers the spill files: up to 256 of up to 1 MiB (direct writes of
     // 64 KiB ran at half the disk's speed of 1 MiB ones here).
     spillBufferBytes = std::clamp<std::uint64_t>(budget / 8 / 256 / kDirectBlock, 16, 256) * kDirectBlock;
@@ -88,6 +88,7 @@ struct MemoryPlan {
     // pieces of DirectReadAhead (4 MiB, more than a sixteenth under --mem 64M), at most 32 MiB.
     readAheadBytes = std::clamp<std::uint64_t>(budget / 16, 4 << 20, 32 << 20);
   }
+  std::uint64_t keyBytes;         ///< of a particle's key and its value, binned in memory
   std::uint64_t chunkParticles;   ///< particles read at once
   std::uint64_t maxBinParticles;  ///< particles binned in memory at once
   std::uint64_t maxBucketFiles;   ///< spill files open at once
@@ -200,9 +201,9 @@ class FrameBinner {
     // The next bucket's records are read while this one is binned (on a thread that waits on the
     // disk; they are unpacked on every core at their turn), when the largest bucket's keys and
     // records fit one bin of the budget and no bucket is split again.
-    const std::uint64_t keyBytes = mValues ? 12 : 8;  // a key and its value (MemoryPlan)
-    const bool ahead = mOptions.readAhead && !skewed &&
-                       largest * keyBytes + buckets.recordBufferBytes(largest) <= mPlan.maxBinParticles * keyBytes;
+    const bool ahead =
+        mOptions.readAhead && !skewed &&
+        largest * mPlan.keyBytes + buckets.recordBufferBytes(largest) <= mPlan.maxBinParticles * mPlan.keyBytes;
     mKeys.cellKeys.reserve(largest);
     if (mValues) mKeys.values.reserve(largest);
     if (ahead && mNextRecords.size() < buckets.recordBufferBytes(largest))

@@ -123,7 +123,7 @@ void SpillBuckets::forEachRecord(std::size_t b, Fn&& fn) const {
   if (!bucket.records) return;
   FLIPSCOPE_CHECK(!bucket.removed, "spill bucket " << b << " read after its removal");
   DirectFile file(bucket.path, DirectFile::Mode::Read);
-  const std::size_t bytes = mLayout.recordBytes(), keyBytes = mLayout.keyBytes();
+  const std::size_t bytes = mLayout.recordBytes();
   const bool withValues = mLayout.values();
   AlignedBuffer block(4 * mBufferBytes);  // the spill buffers are free by now (finish())
   std::byte carry[kRecordWriteBytes]{};   // a record split across two blocks (take reads its first 12 bytes)
@@ -131,11 +131,7 @@ void SpillBuckets::forEachRecord(std::size_t b, Fn&& fn) const {
   std::uint64_t done = 0;
   // The record at `record`, of which at least 8 + 4 bytes may be read.
   const auto take = [&](const std::byte* record) {
-    std::uint64_t packed;
-    std::memcpy(&packed, record, 8);
-    float value = 0;
-    if (withValues) std::memcpy(&value, record + keyBytes, 4);
-    fn(mLayout.unpack(packed, b), value);
+    fn(mLayout.keyAt(record, b), withValues ? mLayout.valueAt(record) : 0.0f);
     ++done;
   };
   while (done < bucket.records) {
@@ -223,15 +219,13 @@ void SpillBuckets::unpack(std::size_t b, const AlignedBuffer& raw, KeyBatch& bat
   if (withValues) batch.values.resize(records);
   std::uint64_t* keys = batch.cellKeys.data();
   float* values = batch.values.data();
-  const std::size_t bytes = mLayout.recordBytes(), keyBytes = mLayout.keyBytes();
+  const std::size_t bytes = mLayout.recordBytes();
   const std::byte* data = raw.data();
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, records, std::size_t(1) << 16), [&](const auto& range) {
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
       const std::byte* record = data + i * bytes;
-      std::uint64_t packed;
-      std::memcpy(&packed, record, 8);
-      keys[i] = mLayout.unpack(packed, b);
-      if (withValues) std::memcpy(&values[i], record + keyBytes, 4);
+      keys[i] = mLayout.keyAt(record, b);
+      if (withValues) values[i] = mLayout.valueAt(record);
     }
   });
 }

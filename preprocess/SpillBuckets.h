@@ -20,6 +20,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <functional>
 #include <memory>
@@ -56,6 +57,18 @@ class SpillRecordLayout {
     std::uint64_t key = digit << mDigitShift;
     for (std::uint32_t r = 0; r < mRunCount; ++r) key |= ((packed >> mRuns[r].to) & mRuns[r].mask) << mRuns[r].shift;
     return key;
+  }
+  /// The key of bucket `digit` whose record starts at `record`, of which 8 bytes may be read.
+  std::uint64_t keyAt(const std::byte* record, std::uint64_t digit) const {
+    std::uint64_t packed;
+    std::memcpy(&packed, record, 8);
+    return unpack(packed, digit);
+  }
+  /// The value of the record at `record` (values() only).
+  float valueAt(const std::byte* record) const {
+    float value;
+    std::memcpy(&value, record + mKeyBytes, 4);
+    return value;
   }
 
  private:
