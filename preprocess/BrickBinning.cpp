@@ -89,12 +89,13 @@ std::uint64_t gridBricks(const KeyGrid& grid) {
 /// and written twice, within the cache for blocks of up to 64 Ki keys, where the in-place split
 /// (splitByBrick) swaps each key once into a place anywhere in its stripe: a miss a key. On the
 /// 20 M particle PLY's 20 M keys that split was 14 % of the convert. The thread keeps its buffer
-/// (8 bytes a key of its largest block) and counters (4 bytes a code) for the next block.
-void sortBlockByBrick(std::uint64_t* block, std::size_t size, std::size_t first, std::uint32_t lowBit,
-                      std::uint32_t codeBits, std::vector<CodedRun>& runs) {
+/// (a key's bytes of its largest block) and counters (4 bytes a code) for the next block.
+template <class Key>
+void sortBlockByBrick(Key* block, std::size_t size, std::size_t first, std::uint32_t lowBit, std::uint32_t codeBits,
+                      std::vector<CodedRun>& runs) {
   if (size == 0) return;
   const std::uint64_t mask = (std::uint64_t(1) << codeBits) - 1;
-  thread_local UninitializedVector<std::uint64_t> sorted;
+  thread_local UninitializedVector<Key> sorted;
   thread_local std::vector<std::uint32_t> counts;  // zero between blocks
   thread_local std::vector<std::uint32_t> present;
   thread_local bool countsZero = true;  // false only where a block threw before its reset
@@ -116,7 +117,7 @@ void sortBlockByBrick(std::uint64_t* block, std::size_t size, std::size_t first,
   }
   sorted.resize(size);
   for (std::size_t i = 0; i < size; ++i) sorted[counts[std::uint32_t((block[i] >> lowBit) & mask)]++] = block[i];
-  std::memcpy(block, sorted.data(), size * sizeof(std::uint64_t));
+  std::memcpy(block, sorted.data(), size * sizeof(Key));
   for (std::uint32_t code : present) counts[code] = 0;
   countsZero = true;
 }
@@ -147,9 +148,19 @@ ParticleKind kindOfTypeValue(float flags) {
   return fromMantaflowType(std::int32_t(flags));
 }
 
+namespace {
+
+/// computeKeys() into `keyVector`, out's cellKeys or narrowKeys (Key: 8 or 4 bytes).
+template <class Key>
+KeyTally computeKeysInto(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& out,
+                         UninitializedVector<Key>& keyVector, const AttributeColumn* types);
+
+}  // namespace
+
 KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& out, const AttributeColumn* types) {
   const std::size_t n = chunk.size();
   const AttributeKind kind = grid.header.attribute;
+  FLIPSCOPE_CHECK(!out.narrow || grid.narrowKeys(), "narrow keys for a grid whose keys need more than 32 bits");
   FLIPSCOPE_CHECK(!types || (types->arity == 1 && types->values.size() == n),
                   "a type column needs one value a particle");
   FLIPSCOPE_CHECK(kind != AttributeKind::Speed || chunk.velocities.size() == n, "speed needs velocities");
@@ -160,12 +171,23 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& 
                       (!chunk.attributes.empty() &&
                        chunk.attributes.front().values.size() == n * std::size_t(chunk.attributes.front().arity)),
                   "a vector attribute needs its column");
+  return out.narrow ? computeKeysInto(chunk, grid, out, out.narrowKeys, types)
+                    : computeKeysInto(chunk, grid, out, out.cellKeys, types);
+}
+
+namespace {
+
+template <class Key>
+KeyTally computeKeysInto(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& out,
+                         UninitializedVector<Key>& keyVector, const AttributeColumn* types) {
+  const std::size_t n = chunk.size();
+  const AttributeKind kind = grid.header.attribute;
   const bool attribute = grid.attribute();
   const bool separateValues = grid.valuesBesideKeys();
-  const std::size_t base = out.cellKeys.size();
-  out.cellKeys.resize(base + n);
+  const std::size_t base = keyVector.size();
+  keyVector.resize(base + n);
   if (separateValues) out.values.resize(base + n);
-  std::uint64_t* keys = out.cellKeys.data() + base;
+  Key* keys = keyVector.data() + base;
   float* values = separateValues ? out.values.data() + base : nullptr;
   // Fixed blocks, each compacted in place by its own task; skipped particles close up after.
   struct Tally {
@@ -191,7 +213,7 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& 
     const float* typeValues = types ? types->values.data() : nullptr;
     const std::uint64_t *keysX = grid.axisKeys[0].data(), *keysY = grid.axisKeys[1].data(),
                         *keysZ = grid.axisKeys[2].data();
-    std::uint64_t* const keyOut = keys;
+    Key* const keyOut = keys;
     float* const valueOut = values;
     const glm::dvec3 origin = grid.header.origin, limit(grid.cells);
     const double inverseCell = grid.invCellSize;
@@ -222,10 +244,11 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& 
         t.valueMin = std::min(t.valueMin, s);
         t.valueMax = std::max(t.valueMax, s);
       }
+      // A narrow Key holds every bit the grid's keys may set (KeyGrid::narrowKeys).
       if (valueInKey) {
-        keyOut[to] = (((particleKind << kPackedCellBits) | cellKey) << 32) | std::bit_cast<std::uint32_t>(s);
+        keyOut[to] = Key((((particleKind << kPackedCellBits) | cellKey) << 32) | std::bit_cast<std::uint32_t>(s));
       } else {
-        keyOut[to] = (particleKind << kKindShift) | cellKey;
+        keyOut[to] = Key((particleKind << kKindShift) | cellKey);
         if (valueOut) valueOut[to] = s;
       }
       ++to;
@@ -263,10 +286,12 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& 
   } else if (sortBlocks) {
     std::vector<CodedRun>().swap(out.runs);  // out.sortedKeys stays short: binKeys sorts the keys
   }
-  out.cellKeys.resize(base + kept);
+  keyVector.resize(base + kept);
   if (values) out.values.resize(base + kept);
   return result;
 }
+
+}  // namespace
 
 std::uint16_t quantizeAttribute(float s, float min, float max) {
   if (!(max > min) || std::isnan(s)) return 0;
@@ -329,7 +354,8 @@ constexpr std::size_t kParallelThreshold = 1 << 16;
 /// Sorts keys[begin,end) in place by the bits [lowBit, highBit) (the brick code), most
 /// significant digit first (American flag sort: a histogram, then each key swapped into its
 /// digit's range); appends one run per distinct code in ascending code order.
-void splitByBrick(std::uint64_t* keys, std::size_t begin, std::size_t end, std::uint32_t lowBit, std::uint32_t highBit,
+template <class Key>
+void splitByBrick(Key* keys, std::size_t begin, std::size_t end, std::uint32_t lowBit, std::uint32_t highBit,
                   std::vector<BrickRun>& runs) {
   if (begin == end) return;
   if (highBit <= lowBit) {
@@ -340,7 +366,7 @@ void splitByBrick(std::uint64_t* keys, std::size_t begin, std::size_t end, std::
   const std::uint32_t shift = highBit - bits;
   const std::uint64_t mask = (1ull << bits) - 1;
   auto digit = [&](std::uint64_t key) { return std::size_t((key >> shift) & mask); };
-  std::uint64_t* const a = keys + begin;
+  Key* const a = keys + begin;
   const std::size_t n = end - begin;
   // Fast path: every key has the same digit.
   const std::size_t first = digit(a[0]);
@@ -366,7 +392,7 @@ void splitByBrick(std::uint64_t* keys, std::size_t begin, std::size_t end, std::
   for (std::size_t d = 0; d < buckets; ++d) {
     const std::size_t stop = starts[d + 1];
     while (heads[d] < stop) {
-      std::uint64_t key = a[heads[d]];
+      Key key = a[heads[d]];
       for (std::size_t e = digit(key); e != d; e = digit(key)) std::swap(key, a[heads[e]++]);
       a[heads[d]++] = key;
     }
@@ -396,8 +422,9 @@ std::size_t blockKeysFor(std::uint64_t bricks) {
 
 /// Sorts each block of `blockKeys` keys by brick code (sortBlockByBrick), in parallel. Appends
 /// the runs, blocks in order.
-void splitBlocksByBrick(std::uint64_t* keys, std::size_t n, std::uint32_t lowBit, std::uint32_t codeBits,
-                        std::size_t blockKeys, std::vector<CodedRun>& runs) {
+template <class Key>
+void splitBlocksByBrick(Key* keys, std::size_t n, std::uint32_t lowBit, std::uint32_t codeBits, std::size_t blockKeys,
+                        std::vector<CodedRun>& runs) {
   const std::size_t blocks = (n + blockKeys - 1) / blockKeys;
   std::vector<std::vector<CodedRun>> blockRuns(blocks);
   tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
@@ -485,8 +512,9 @@ struct DecodeScratch {
 /// Encodes one brick's keys (same brick code, any order, in the runs of `parts` of `all`, their
 /// fields where `fields` says) into `out` (reuses its vectors); with kinds, a cell's kind is the
 /// smallest of its keys'.
-void decodeRun(std::uint64_t* all, const BrickParts& parts, const KeyGrid& grid, const KeyFields& fields,
-               bool attribute, DecodedBrick& out, DecodeScratch& scratch) {
+template <class Key>
+void decodeRun(Key* all, const BrickParts& parts, const KeyGrid& grid, const KeyFields& fields, bool attribute,
+               DecodedBrick& out, DecodeScratch& scratch) {
   const bool kinds = fields.kinds;
   std::vector<std::uint32_t>& histogram = scratch.histogram;
   std::vector<ParticleKind>& cellKinds = scratch.cellKinds;
@@ -506,9 +534,13 @@ void decodeRun(std::uint64_t* all, const BrickParts& parts, const KeyGrid& grid,
   };
   if (total * 16 < cellsPerBrick) {
     // Sparse: sort the binning keys, (cell, attribute), directly.
-    const BrickRun& first = parts.runs[0].run;
-    std::span<std::uint64_t> keys(all + first.begin, first.end - first.begin);
-    if (parts.runs.size() > 1 || fields.layout != KeyFields::Layout::Binning) {
+    std::span<std::uint64_t> keys;
+    if constexpr (std::is_same_v<Key, std::uint64_t>) {
+      const BrickRun& first = parts.runs[0].run;
+      if (parts.runs.size() == 1 && fields.layout == KeyFields::Layout::Binning)
+        keys = {all + first.begin, first.end - first.begin};
+    }
+    if (keys.empty()) {
       gathered.clear();
       forEachKey([&](std::uint64_t k) { gathered.push_back(fields.binningKeyOf(k)); });
       keys = gathered;
@@ -565,20 +597,10 @@ void decodeRun(std::uint64_t* all, const BrickParts& parts, const KeyGrid& grid,
   }
 }
 
-}  // namespace
-
-void binKeys(KeyBatch& keyBatch, const KeyGrid& grid, float min, float max, int zstdLevel,
-             const std::function<void(const EncodedBrick&)>& sink) {
-  KeyFields fields;
-  fields.kinds = grid.header.particleKinds;
-  fields.min = min;
-  fields.max = max;
-  fields.cellBits = grid.cellBits;
-  if (grid.valuesBesideKeys())  // the values must travel with the keys through the split
-    makeBinningKeys(keyBatch, grid, min, max);
-  else
-    fields.layout = grid.attribute() ? KeyFields::Layout::Packed : KeyFields::Layout::Plain;
-  std::span<std::uint64_t> keys(keyBatch.cellKeys);
+/// binKeys() of `keys`, keyBatch's cellKeys or narrowKeys, whose fields lie where `fields` says.
+template <class Key>
+void binKeysOf(std::span<Key> keys, KeyBatch& keyBatch, const KeyGrid& grid, const KeyFields& fields, int zstdLevel,
+               const std::function<void(const EncodedBrick&)>& sink) {
   if (keys.empty()) return;
   const bool attribute = grid.attribute();
   const std::uint32_t lowBit = fields.codeShift();
@@ -644,6 +666,26 @@ void binKeys(KeyBatch& keyBatch, const KeyGrid& grid, float min, float max, int 
   tbb::parallel_pipeline(slots, tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order, eachBrick) &
                                     tbb::make_filter<std::size_t, std::size_t>(tbb::filter_mode::parallel, encode) &
                                     tbb::make_filter<std::size_t, void>(tbb::filter_mode::serial_in_order, write));
+}
+
+}  // namespace
+
+void binKeys(KeyBatch& keyBatch, const KeyGrid& grid, float min, float max, int zstdLevel,
+             const std::function<void(const EncodedBrick&)>& sink) {
+  KeyFields fields;
+  fields.kinds = grid.header.particleKinds;
+  fields.min = min;
+  fields.max = max;
+  fields.cellBits = grid.cellBits;
+  if (grid.valuesBesideKeys())  // the values must travel with the keys through the split
+    makeBinningKeys(keyBatch, grid, min, max);
+  else
+    fields.layout = grid.attribute() ? KeyFields::Layout::Packed : KeyFields::Layout::Plain;
+  // A narrow key is a Plain one whose upper half is 0 (KeyGrid::narrowKeys): the same fields.
+  if (keyBatch.narrow)
+    binKeysOf(std::span<std::uint32_t>(keyBatch.narrowKeys), keyBatch, grid, fields, zstdLevel, sink);
+  else
+    binKeysOf(std::span<std::uint64_t>(keyBatch.cellKeys), keyBatch, grid, fields, zstdLevel, sink);
 }
 
 }  // namespace flipscope::detail

@@ -114,6 +114,7 @@ class FrameBinner {
         mKeys(keys) {
     mKeys.clear();
     mKeys.sortRuns = true;
+    mKeys.narrow = grid.narrowKeys();  // 4 bytes a key where they fit, until spilling starts
     mBatch.sortRuns = false;  // the spill files take its keys in any order
   }
 
@@ -136,12 +137,15 @@ class FrameBinner {
       mReserved = true;
       const std::uint64_t keys =
           std::min(mPlan.maxBinParticles, mExpectedParticles.value_or(mPlan.maxBinParticles)) + mPlan.chunkParticles;
-      mKeys.cellKeys.reserve(keys);
+      if (mKeys.narrow)
+        mKeys.narrowKeys.reserve(keys);
+      else
+        mKeys.cellKeys.reserve(keys);
       if (mValues) mKeys.values.reserve(keys);
       mKeys.runs.reserve(keys / detail::kKeysPerRun + 1);  // untouched unless computeKeys sorts
     }
     account(detail::computeKeys(chunk, mGrid, mKeys, types));
-    if (mKeys.cellKeys.size() > mPlan.maxBinParticles) startSpilling();
+    if (mKeys.keyCount() > mPlan.maxBinParticles) startSpilling();
   }
 
   /// Bins everything added into `writer`; returns the frame's stats.
@@ -174,14 +178,27 @@ class FrameBinner {
     return std::min(bits, availableBits);
   }
 
-  /// Moves the keys binned so far into bucket files. mKeys keeps its memory: the buckets are
-  /// loaded into it, and pages touched once are not paid for again.
+  /// Moves the keys binned so far into bucket files. mKeys keeps its memory, unless its keys
+  /// were narrow: the buckets are loaded into it (8 bytes a key), and pages touched once are not
+  /// paid for again.
   void startSpilling() {
     const std::uint32_t bits = bucketBitsFor(mGrid.codeBits);
     const std::uint32_t shift = mGrid.cellKeyShift() + mGrid.cellBits + mGrid.codeBits - bits;
     mSpill = std::make_unique<SpillBuckets>(mScratch, mPrefix, mGrid.batchKeyBits(), shift, bits, mValues,
                                             mPlan.spillBufferBytes);
-    mSpill->add(mKeys.cellKeys.data(), mKeys.values.data(), mKeys.cellKeys.size());
+    if (mKeys.narrow) {
+      // Widened a chunk's worth at a time in mBatch, the spilled chunks' batch; then freed.
+      const std::uint32_t* narrow = mKeys.narrowKeys.data();
+      for (std::size_t from = 0, n = mKeys.narrowKeys.size(); from < n; from += mPlan.chunkParticles) {
+        mBatch.cellKeys.assign(narrow + from, narrow + std::min<std::size_t>(n, from + mPlan.chunkParticles));
+        mSpill->add(mBatch.cellKeys.data(), nullptr, mBatch.cellKeys.size());
+      }
+      mBatch.clear();
+      detail::NarrowKeyVector().swap(mKeys.narrowKeys);
+      mKeys.narrow = false;
+    } else {
+      mSpill->add(mKeys.cellKeys.data(), mKeys.values.data(), mKeys.cellKeys.size());
+    }
     mKeys.clear();
     std::vector<detail::CodedRun>().swap(mKeys.runs);  // the buckets loaded into mKeys have none
     mSpillBuckets += std::uint32_t(mSpill->size());

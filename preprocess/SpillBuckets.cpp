@@ -180,6 +180,7 @@ void SpillBuckets::forEachPiece(std::size_t b, const PieceFn& fn) const {
 }
 
 void SpillBuckets::load(std::size_t b, KeyBatch& batch) const {
+  FLIPSCOPE_CHECK(!batch.narrow, "spill bucket " << b << " loaded into a batch of narrow keys");
   batch.clear();
   const bool withValues = mLayout.values();
   batch.cellKeys.resize(mBuckets[b].records);
@@ -213,6 +214,7 @@ void SpillBuckets::readRecords(std::size_t b, AlignedBuffer& raw) const {
 void SpillBuckets::unpack(std::size_t b, const AlignedBuffer& raw, KeyBatch& batch) const {
   const std::uint64_t records = mBuckets[b].records;
   FLIPSCOPE_CHECK(raw.size() >= recordBufferBytes(records), "spill bucket " << b << " in " << raw.size() << " bytes");
+  FLIPSCOPE_CHECK(!batch.narrow, "spill bucket " << b << " unpacked into a batch of narrow keys");
   batch.clear();
   const bool withValues = mLayout.values();
   batch.cellKeys.resize(records);

@@ -115,7 +115,8 @@ class SpillBuckets {
   /// Streams bucket b (after finish()) in pieces of at most kPieceKeys keys, in the order its
   /// records were added.
   void forEachPiece(std::size_t b, const PieceFn& fn) const;
-  /// Loads bucket b (after finish()) into `batch`, its file read a few buffers at a time.
+  /// Loads bucket b (after finish()) into `batch` (its cellKeys: not a narrow batch), its file
+  /// read a few buffers at a time.
   void load(std::size_t b, KeyBatch& batch) const;
   /// The bytes of a buffer that readRecords() fills for a bucket of `records` records.
   std::size_t recordBufferBytes(std::uint64_t records) const;
@@ -123,8 +124,8 @@ class SpillBuckets {
   /// (`raw` grows to recordBufferBytes(records(b)) where it is smaller): the disk's work alone,
   /// for a thread that waits on it while the others compute. unpack() then makes the keys.
   void readRecords(std::size_t b, AlignedBuffer& raw) const;
-  /// Bucket b's keys (and values) into `batch`, from `raw` as readRecords(b, raw) left it, on
-  /// every core.
+  /// Bucket b's keys (and values) into `batch` (its cellKeys: not a narrow batch), from `raw` as
+  /// readRecords(b, raw) left it, on every core.
   void unpack(std::size_t b, const AlignedBuffer& raw, KeyBatch& batch) const;
   /// Removes bucket b's file, once it was read: it is read no more (records(b) still counts
   /// it). May run on one thread while others read other buckets (not bucket b, nor beside the

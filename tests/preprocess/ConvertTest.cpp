@@ -189,6 +189,9 @@ struct OutOfCoreCase {
   /// Particles in order along x, as a solver's cache often is (near particles near in the file):
   /// then a block of keys touches few bricks, and computeKeys keeps its runs.
   bool alongX = false;
+  /// The store's attribute: without one, keys of at most 32 bits are binned in memory as narrow
+  /// keys (KeyBatch::narrow), and spilled as the 8-byte keys they widen to.
+  AttributeKind attribute = AttributeKind::Speed;
 };
 
 class ConvertOutOfCore : public ::testing::TestWithParam<OutOfCoreCase> {};
@@ -210,14 +213,16 @@ TEST_P(ConvertOutOfCore, StoreIsByteIdenticalToInCoreWithAndWithoutReadAhead) {
   options.brickSize = c.brickSize;
   options.progress = Progress::Mode::Silent;
   const Box domain{{0, 0, 0}, glm::dvec3(50.0f * c.stretch)};
-  ASSERT_EQ(detail::KeyGrid(makeStoreHeader(domain, options, AttributeKind::Speed)).valueInKey, c.valueInKey);
+  const detail::KeyGrid grid(makeStoreHeader(domain, options, c.attribute));
+  ASSERT_EQ(grid.valueInKey, c.valueInKey);
+  ASSERT_EQ(grid.narrowKeys(), c.attribute == AttributeKind::None);
   testing::TempDir temp("out-of-core");
   auto run = [&](std::uint64_t budget, const std::string& name, bool readAhead = true, bool hintsCount = true,
                  std::optional<std::uint64_t> wrongCount = std::nullopt) {
     options.memoryBudget = budget;
     options.readAhead = readAhead;
     const fs::path dir = temp / name;
-    StoreHeader header = makeStoreHeader(domain, options, AttributeKind::Speed);
+    StoreHeader header = makeStoreHeader(domain, options, c.attribute);
     header.id = {7, 7, 7};  // the same id for both stores: then the files are the same bytes
     BrickStore store = BrickStore::createOrAppend(dir, header);
     testing::VectorSource source(positions, velocities);
@@ -270,12 +275,17 @@ TEST_P(ConvertOutOfCore, StoreIsByteIdenticalToInCoreWithAndWithoutReadAhead) {
 // 1000 cells of 64: 30 bits of cell key, the value rides in the key; 2500 cells of 128: 36 bits,
 // the value travels beside it; 500 cells of 64: 8^3 bricks, few enough for computeKeys to sort
 // its keys (and keep their runs: the particles in order along x); 4000 by 80 by 80 cells of 32 (200 x 4 x 4): 125 x 3 x
-// 3 bricks, split in stripes.
+// 3 bricks, split in stripes. Without an attribute, narrow keys: sorted as they are made (8^3
+// bricks) or by binKeys a block at a time (16^3 bricks). Narrow keys never take the stripes: the
+// grids whose cell keys fit 32 bits have at most 32 bricks along an axis.
 INSTANTIATE_TEST_SUITE_P(
     KeyLayouts, ConvertOutOfCore,
     ::testing::Values(OutOfCoreCase{64, 0.05, true, "ValueInKey"}, OutOfCoreCase{128, 0.02, false, "ValueBesideKey"},
                       OutOfCoreCase{64, 0.1, true, "FewBricksSortedAsKeysAreMade", glm::vec3(1.0f), true},
-                      OutOfCoreCase{32, 0.05, false, "LongThinGridInStripes", {4.0f, 0.08f, 0.08f}}),
+                      OutOfCoreCase{32, 0.05, false, "LongThinGridInStripes", {4.0f, 0.08f, 0.08f}},
+                      OutOfCoreCase{64, 0.1, false, "NarrowKeysSortedAsTheyAreMade", glm::vec3(1.0f), true,
+                                    AttributeKind::None},
+                      OutOfCoreCase{64, 0.05, false, "NarrowKeys", glm::vec3(1.0f), false, AttributeKind::None}),
     [](const auto& info) { return std::string(info.param.name); });
 
 // convert's binning pass reads its input once, around the page cache where it is not cached
@@ -334,6 +344,8 @@ TEST(Convert, AFileReadAroundThePageCacheGivesTheSameStoreInCoreAndOutOfCore) {
 // convert keeps the storage of a frame's keys for the next frame (its pages touched once): frames
 // of a sequence that shrinks and grows, their keys sorted as they are made (particles in order
 // along x: runs kept) or not (random order), convert into the frames of converts one frame each.
+// So they do without an attribute (narrow keys), also where the first and last frames spill
+// (under 2 MiB, 157286 particles a bin: then the keys of the frame after are narrow again).
 TEST(Convert, FramesBinnedInTheKeysOfTheFrameBeforeAreTheFramesConvertedAlone) {
   testing::TempDir temp("reused-keys");
   const std::size_t counts[] = {300000, 100000, 200000};
@@ -358,9 +370,21 @@ TEST(Convert, FramesBinnedInTheKeysOfTheFrameBeforeAreTheFramesConvertedAlone) {
   options.particleSpacing = 0.05;
   options.domain = Box{{0, 0, 0}, {50, 50, 50}};
   options.progress = Progress::Mode::Silent;
-  convert(inputs, temp / "sequence", options);
-  for (const FrameInput& input : inputs) convert({input}, temp / "one-by-one", options);  // appended
-  testing::expectSameFrames(temp / "sequence", temp / "one-by-one");
+  const auto sequenceAndOneByOne = [&](const std::string& name) {
+    const ConvertReport sequence = convert(inputs, temp / (name + "-sequence"), options);
+    for (const FrameInput& input : inputs) convert({input}, temp / (name + "-one-by-one"), options);  // appended
+    testing::expectSameFrames(temp / (name + "-sequence"), temp / (name + "-one-by-one"));
+    return sequence;
+  };
+  sequenceAndOneByOne("speed");
+  options.attribute = "none";
+  sequenceAndOneByOne("narrow");
+  options.memoryBudget = 2 << 20;
+  const ConvertReport spilled = sequenceAndOneByOne("narrow-spilled");
+  ASSERT_EQ(spilled.frames.size(), 3u);
+  EXPECT_GT(spilled.frames[0].spillBuckets, 0u);
+  EXPECT_EQ(spilled.frames[1].spillBuckets, 0u);
+  EXPECT_GT(spilled.frames[2].spillBuckets, 0u);
 }
 
 // computeKeys keeps the runs of its sorted blocks only while they stay within one per
