@@ -83,28 +83,41 @@ std::uint64_t gridBricks(const KeyGrid& grid) {
   return bricks.x * bricks.y * bricks.z;
 }
 
+/// sortBlockByBrick's counters, kept by each thread from block to block.
+struct BlockSortCounters {
+  std::vector<std::uint32_t> counts;   ///< a code's keys, then its next place; zero between blocks
+  std::vector<std::uint32_t> present;  ///< the codes of the block
+  bool countsZero = true;              ///< false only where a block threw before its reset
+};
+BlockSortCounters& threadBlockSortCounters() {
+  thread_local BlockSortCounters counters;
+  return counters;
+}
+
 /// Sorts block[0, size) by brick code (`codeBits` bits from `lowBit`): a count of each code,
 /// then every key copied to its code's place in a buffer of the thread's and back. Appends one
 /// run per code, ascending, at `first` plus its place in the block. Each key is read three times
 /// and written twice, within the cache for blocks of up to 64 Ki keys, where the in-place split
 /// (splitByBrick) swaps each key once into a place anywhere in its stripe: a miss a key. On the
 /// 20 M particle PLY's 20 M keys that split was 14 % of the convert. The thread keeps its buffer
-/// (a key's bytes of its largest block) and counters (4 bytes a code) for the next block.
+/// (its largest block, 4 or 8 bytes a key) and counters (4 bytes a code, one set for both key
+/// sizes: BlockSortCounters) for the next block.
 template <class Key>
 void sortBlockByBrick(Key* block, std::size_t size, std::size_t first, std::uint32_t lowBit, std::uint32_t codeBits,
                       std::vector<CodedRun>& runs) {
   if (size == 0) return;
   const std::uint64_t mask = (std::uint64_t(1) << codeBits) - 1;
   thread_local UninitializedVector<Key> sorted;
-  thread_local std::vector<std::uint32_t> counts;  // zero between blocks
-  thread_local std::vector<std::uint32_t> present;
-  thread_local bool countsZero = true;  // false only where a block threw before its reset
+  BlockSortCounters& counters = threadBlockSortCounters();
+  std::vector<std::uint32_t>& counts = counters.counts;
+  std::vector<std::uint32_t>& present = counters.present;
+  bool& countsZero = counters.countsZero;
   if (!countsZero) std::fill(counts.begin(), counts.end(), 0u);
   countsZero = false;
   counts.resize(std::size_t(1) << codeBits);
   present.clear();
   for (std::size_t i = 0; i < size; ++i) {
-    const auto code = std::uint32_t((block[i] >> lowBit) & mask);
+    const auto code = std::uint32_t((std::uint64_t(block[i]) >> lowBit) & mask);
     if (counts[code]++ == 0) present.push_back(code);
   }
   std::sort(present.begin(), present.end());
@@ -116,7 +129,8 @@ void sortBlockByBrick(Key* block, std::size_t size, std::size_t first, std::uint
     offset += count;
   }
   sorted.resize(size);
-  for (std::size_t i = 0; i < size; ++i) sorted[counts[std::uint32_t((block[i] >> lowBit) & mask)]++] = block[i];
+  for (std::size_t i = 0; i < size; ++i)
+    sorted[counts[std::uint32_t((std::uint64_t(block[i]) >> lowBit) & mask)]++] = block[i];
   std::memcpy(block, sorted.data(), size * sizeof(Key));
   for (std::uint32_t code : present) counts[code] = 0;
   countsZero = true;
@@ -161,6 +175,7 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& 
   const std::size_t n = chunk.size();
   const AttributeKind kind = grid.header.attribute;
   FLIPSCOPE_CHECK(!out.narrow || grid.narrowKeys(), "narrow keys for a grid whose keys need more than 32 bits");
+  FLIPSCOPE_CHECK(!out.narrow || !types, "narrow keys carry no kinds");
   FLIPSCOPE_CHECK(!types || (types->arity == 1 && types->values.size() == n),
                   "a type column needs one value a particle");
   FLIPSCOPE_CHECK(kind != AttributeKind::Speed || chunk.velocities.size() == n, "speed needs velocities");
@@ -171,8 +186,7 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& 
                       (!chunk.attributes.empty() &&
                        chunk.attributes.front().values.size() == n * std::size_t(chunk.attributes.front().arity)),
                   "a vector attribute needs its column");
-  return out.narrow ? computeKeysInto(chunk, grid, out, out.narrowKeys, types)
-                    : computeKeysInto(chunk, grid, out, out.cellKeys, types);
+  return out.withKeys([&](auto& keys) { return computeKeysInto(chunk, grid, out, keys, types); });
 }
 
 namespace {
@@ -354,8 +368,7 @@ constexpr std::size_t kParallelThreshold = 1 << 16;
 /// Sorts keys[begin,end) in place by the bits [lowBit, highBit) (the brick code), most
 /// significant digit first (American flag sort: a histogram, then each key swapped into its
 /// digit's range); appends one run per distinct code in ascending code order.
-template <class Key>
-void splitByBrick(Key* keys, std::size_t begin, std::size_t end, std::uint32_t lowBit, std::uint32_t highBit,
+void splitByBrick(std::uint64_t* keys, std::size_t begin, std::size_t end, std::uint32_t lowBit, std::uint32_t highBit,
                   std::vector<BrickRun>& runs) {
   if (begin == end) return;
   if (highBit <= lowBit) {
@@ -366,7 +379,7 @@ void splitByBrick(Key* keys, std::size_t begin, std::size_t end, std::uint32_t l
   const std::uint32_t shift = highBit - bits;
   const std::uint64_t mask = (1ull << bits) - 1;
   auto digit = [&](std::uint64_t key) { return std::size_t((key >> shift) & mask); };
-  Key* const a = keys + begin;
+  std::uint64_t* const a = keys + begin;
   const std::size_t n = end - begin;
   // Fast path: every key has the same digit.
   const std::size_t first = digit(a[0]);
@@ -392,7 +405,7 @@ void splitByBrick(Key* keys, std::size_t begin, std::size_t end, std::uint32_t l
   for (std::size_t d = 0; d < buckets; ++d) {
     const std::size_t stop = starts[d + 1];
     while (heads[d] < stop) {
-      Key key = a[heads[d]];
+      std::uint64_t key = a[heads[d]];
       for (std::size_t e = digit(key); e != d; e = digit(key)) std::swap(key, a[heads[e]++]);
       a[heads[d]++] = key;
     }
@@ -534,13 +547,15 @@ void decodeRun(Key* all, const BrickParts& parts, const KeyGrid& grid, const Key
   };
   if (total * 16 < cellsPerBrick) {
     // Sparse: sort the binning keys, (cell, attribute), directly.
+    // In place where the brick's keys are one run of binning keys; else gathered as binning keys.
     std::span<std::uint64_t> keys;
+    bool inPlace = false;
     if constexpr (std::is_same_v<Key, std::uint64_t>) {
       const BrickRun& first = parts.runs[0].run;
-      if (parts.runs.size() == 1 && fields.layout == KeyFields::Layout::Binning)
-        keys = {all + first.begin, first.end - first.begin};
+      inPlace = parts.runs.size() == 1 && fields.layout == KeyFields::Layout::Binning;
+      if (inPlace) keys = {all + first.begin, first.end - first.begin};
     }
-    if (keys.empty()) {
+    if (!inPlace) {
       gathered.clear();
       forEachKey([&](std::uint64_t k) { gathered.push_back(fields.binningKeyOf(k)); });
       keys = gathered;
@@ -597,6 +612,18 @@ void decodeRun(Key* all, const BrickParts& parts, const KeyGrid& grid, const Key
   }
 }
 
+/// What binKeys keeps, a set a thread, from brick to brick (one set for both key sizes).
+std::pair<DecodedBrick, DecodeScratch>& threadEncodeScratch() {
+  thread_local std::pair<DecodedBrick, DecodeScratch> scratch;
+  return scratch;
+}
+
+/// Narrow keys are never split by stripes: their grids' cell keys fit 32 bits, of which the
+/// cell in a brick takes 15 at least (bricks of 32^3), which leaves at most 15 bits of brick code
+/// (3 a level of the octree): at most 32^3 bricks.
+constexpr std::uint32_t kNarrowCodeBits = (32 - 15) / 3 * 3;
+static_assert(kNarrowCodeBits <= kBlockSplitCodeBits && (std::uint64_t(1) << kNarrowCodeBits) <= kBlockSplitBricks);
+
 /// binKeys() of `keys`, keyBatch's cellKeys or narrowKeys, whose fields lie where `fields` says.
 template <class Key>
 void binKeysOf(std::span<Key> keys, KeyBatch& keyBatch, const KeyGrid& grid, const KeyFields& fields, int zstdLevel,
@@ -612,6 +639,8 @@ void binKeysOf(std::span<Key> keys, KeyBatch& keyBatch, const KeyGrid& grid, con
     coded.swap(keyBatch.runs);  // computeKeys sorted them already
   } else if (gridBricks(grid) <= kBlockSplitBricks && grid.codeBits <= kBlockSplitCodeBits) {
     splitBlocksByBrick(keys.data(), keys.size(), lowBit, grid.codeBits, blockKeysFor(gridBricks(grid)), coded);
+  } else if constexpr (!std::is_same_v<Key, std::uint64_t>) {
+    FLIPSCOPE_CHECK(false, "narrow keys on a grid of " << gridBricks(grid) << " bricks, split by stripes");
   } else {
     // The in-place split moves keys one at a time: stripes of the keys are split on their own,
     // in parallel.
@@ -650,8 +679,7 @@ void binKeysOf(std::span<Key> keys, KeyBatch& keyBatch, const KeyGrid& grid, con
   };
   const auto encode = [&](std::size_t k) {
     const BrickParts& parts = bricks[k];
-    thread_local DecodedBrick brick;
-    thread_local DecodeScratch scratch;
+    auto& [brick, scratch] = threadEncodeScratch();
     decodeRun(keys.data(), parts, grid, fields, attribute, brick, scratch);
     EncodedBrick& e = ring[k % slots];
     e.kindCells = {};
@@ -682,10 +710,8 @@ void binKeys(KeyBatch& keyBatch, const KeyGrid& grid, float min, float max, int 
   else
     fields.layout = grid.attribute() ? KeyFields::Layout::Packed : KeyFields::Layout::Plain;
   // A narrow key is a Plain one whose upper half is 0 (KeyGrid::narrowKeys): the same fields.
-  if (keyBatch.narrow)
-    binKeysOf(std::span<std::uint32_t>(keyBatch.narrowKeys), keyBatch, grid, fields, zstdLevel, sink);
-  else
-    binKeysOf(std::span<std::uint64_t>(keyBatch.cellKeys), keyBatch, grid, fields, zstdLevel, sink);
+  FLIPSCOPE_CHECK(!keyBatch.narrow || grid.narrowKeys(), "narrow keys for a grid whose keys need more than 32 bits");
+  keyBatch.withKeys([&](auto& keys) { binKeysOf(std::span(keys), keyBatch, grid, fields, zstdLevel, sink); });
 }
 
 }  // namespace flipscope::detail

@@ -1,5 +1,6 @@
 // BrickBinning: the in-memory core of the preprocess (Reichl et al. 2014 §3, Fig. 2).
-// Particles become 64-bit sort keys; a bucket of keys becomes Morton-ordered, encoded bricks.
+// Particles become 64-bit sort keys (32-bit where they fit: KeyBatch::narrow); a bucket of keys
+// becomes Morton-ordered, encoded bricks.
 //
 // Key layout (fits because a store has at most 65536 = 2^16 cells per axis):
 //   [ brick Morton code : 3*(16 - log2 B) bits ][ cell in brick : 3*log2 B bits ][ attribute : 16 bits ]
@@ -113,6 +114,11 @@ struct KeyBatch {
   /// Whether the keys are narrowKeys (set before keys are added; only for grids whose keys fit).
   bool narrow = false;
   std::size_t keyCount() const { return narrow ? narrowKeys.size() : cellKeys.size(); }
+  /// f(the keys' vector): narrowKeys where `narrow`, else cellKeys.
+  template <class F>
+  decltype(auto) withKeys(F&& f) {
+    return narrow ? f(narrowKeys) : f(cellKeys);
+  }
   void clear() {
     cellKeys.clear();
     narrowKeys.clear();
@@ -147,7 +153,9 @@ ParticleKind kindOfTypeValue(float flags);
 /// axis whose values lie in the keys, each block of 16 Ki particles' keys is sorted by brick and
 /// its runs kept (KeyBatch::runs), where `out` asks for them (sortRuns) and its keys so far are
 /// all sorted; not where the runs would pass one per kKeysPerRun keys (plus one a brick): then
-/// `out` keeps no runs, and binKeys() sorts its keys.
+/// `out` keeps no runs, and binKeys() sorts its keys. The keys go to out.narrowKeys where `out` is
+/// narrow (only for a grid whose keys fit, KeyGrid::narrowKeys, and without `types`), else to
+/// out.cellKeys.
 KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& out,
                      const AttributeColumn* types = nullptr);
 
@@ -184,9 +192,9 @@ struct EncodedBrick {
 /// order. Memory: the keys; twice the threads' count of compressed payloads; the runs, 24 bytes
 /// each, at most one per kKeysPerRun keys (plus one a brick) when sorted by blocks, at most one
 /// a brick in each of 8 stripes otherwise; and, kept by each thread for the next call, a block of
-/// keys (64 Ki, more for grids of over 2 Ki bricks, at most 1 Mi: 8 MiB) and a counter a brick
-/// code (at most 1 MiB). `sink` runs on any one thread at a time; the brick it is given is valid
-/// only during the call.
+/// keys (64 Ki, more for grids of over 2 Ki bricks, at most 1 Mi: 8 MiB, 4 for narrow keys; a
+/// thread that has binned both sizes keeps both) and a counter a brick code (at most 1 MiB). `sink` runs on any one
+/// thread at a time; the brick it is given is valid only during the call.
 void binKeys(KeyBatch& batch, const KeyGrid& grid, float min, float max, int zstdLevel,
              const std::function<void(const EncodedBrick&)>& sink);
 

@@ -88,7 +88,9 @@ struct MemoryPlan {
     // pieces of DirectReadAhead (4 MiB, more than a sixteenth under --mem 64M), at most 32 MiB.
     readAheadBytes = std::clamp<std::uint64_t>(budget / 16, 4 << 20, 32 << 20);
   }
-  std::uint64_t keyBytes;         ///< of a particle's key and its value, binned in memory
+  /// Of a particle's key and its value, binned in memory: 8 for narrow keys too (KeyBatch), since a
+  /// spill bucket is binned in 8-byte keys; a frame of narrow keys in core takes half its share.
+  std::uint64_t keyBytes;
   std::uint64_t chunkParticles;   ///< particles read at once
   std::uint64_t maxBinParticles;  ///< particles binned in memory at once
   std::uint64_t maxBucketFiles;   ///< spill files open at once
@@ -115,6 +117,12 @@ class FrameBinner {
     mKeys.clear();
     mKeys.sortRuns = true;
     mKeys.narrow = grid.narrowKeys();  // 4 bytes a key where they fit, until spilling starts
+    // The other size's storage is freed: a frame that spilled kept 8-byte keys, which the plan
+    // does not count beside the narrow ones of the frame after.
+    if (mKeys.narrow)
+      detail::KeyVector().swap(mKeys.cellKeys);
+    else
+      detail::NarrowKeyVector().swap(mKeys.narrowKeys);
     mBatch.sortRuns = false;  // the spill files take its keys in any order
   }
 
@@ -137,10 +145,7 @@ class FrameBinner {
       mReserved = true;
       const std::uint64_t keys =
           std::min(mPlan.maxBinParticles, mExpectedParticles.value_or(mPlan.maxBinParticles)) + mPlan.chunkParticles;
-      if (mKeys.narrow)
-        mKeys.narrowKeys.reserve(keys);
-      else
-        mKeys.cellKeys.reserve(keys);
+      mKeys.withKeys([&](auto& vector) { vector.reserve(keys); });
       if (mValues) mKeys.values.reserve(keys);
       mKeys.runs.reserve(keys / detail::kKeysPerRun + 1);  // untouched unless computeKeys sorts
     }
@@ -178,9 +183,9 @@ class FrameBinner {
     return std::min(bits, availableBits);
   }
 
-  /// Moves the keys binned so far into bucket files. mKeys keeps its memory, unless its keys
-  /// were narrow: the buckets are loaded into it (8 bytes a key), and pages touched once are not
-  /// paid for again.
+  /// Moves the keys binned so far into bucket files. mKeys keeps its memory, where its keys were
+  /// 8 bytes: the buckets are loaded into it, and pages touched once are not paid for again.
+  /// Narrow keys are freed: the buckets' keys take fresh pages.
   void startSpilling() {
     const std::uint32_t bits = bucketBitsFor(mGrid.codeBits);
     const std::uint32_t shift = mGrid.cellKeyShift() + mGrid.cellBits + mGrid.codeBits - bits;
@@ -789,7 +794,7 @@ namespace {
 
 /// convertFrame(); `frameless`: store.fsh of a store without frames, kept once this frame is listed.
 /// `keys`: FrameBinner's, kept by convert() from frame to frame: the pages of the frame's keys
-/// (8 or 12 bytes a particle) are then fresh memory only once. The kernel zeroing fresh pages was
+/// (4, 8 or 12 bytes a particle) are then fresh memory only once. The kernel zeroing fresh pages was
 /// the largest part of a convert's profile on the development VM (up to 41 % of the samples of
 /// the 100 M particle frame's).
 FrameReport convertOneFrame(ParticleSource& source, BrickStore& store, int frame, const ConvertOptions& options,
