@@ -193,8 +193,8 @@ struct EncodedBrick {
 /// each, at most one per kKeysPerRun keys (plus one a brick) when sorted by blocks, at most one
 /// a brick in each of 8 stripes otherwise; and, kept by each thread for the next call, a block of
 /// keys (64 Ki, more for grids of over 2 Ki bricks, at most 1 Mi: 8 MiB, 4 for narrow keys; a
-/// thread that has binned both sizes keeps both) and a counter a brick code (at most 1 MiB). `sink` runs on any one
-/// thread at a time; the brick it is given is valid only during the call.
+/// thread that has binned both sizes keeps both) and a counter a brick code (at most 1 MiB).
+/// `sink` runs on any one thread at a time; the brick it is given is valid only during the call.
 void binKeys(KeyBatch& batch, const KeyGrid& grid, float min, float max, int zstdLevel,
              const std::function<void(const EncodedBrick&)>& sink);
 
