@@ -111,8 +111,18 @@ struct KeyBatch {
   std::size_t sortedKeys = 0;
   /// Whether computeKeys() sorts and keeps runs (not for keys that go to spill files).
   bool sortRuns = true;
-  /// Whether the keys are narrowKeys (set before keys are added; only for grids whose keys fit).
+  /// Whether the keys are narrowKeys (set by setNarrow before keys are added; only for grids
+  /// whose keys fit).
   bool narrow = false;
+  /// Sets `narrow` and frees the other size's keys: storage kept from batch to batch serves only
+  /// the size in use, so the two are never held at once.
+  void setNarrow(bool on) {
+    narrow = on;
+    if (on)
+      KeyVector().swap(cellKeys);
+    else
+      NarrowKeyVector().swap(narrowKeys);
+  }
   std::size_t keyCount() const { return narrow ? narrowKeys.size() : cellKeys.size(); }
   /// f(the keys' vector): narrowKeys where `narrow`, else cellKeys.
   template <class F>

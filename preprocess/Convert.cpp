@@ -116,13 +116,9 @@ class FrameBinner {
         mKeys(keys) {
     mKeys.clear();
     mKeys.sortRuns = true;
-    mKeys.narrow = grid.narrowKeys();  // 4 bytes a key where they fit, until spilling starts
-    // The other size's storage is freed: a frame that spilled kept 8-byte keys, which the plan
-    // does not count beside the narrow ones of the frame after.
-    if (mKeys.narrow)
-      detail::KeyVector().swap(mKeys.cellKeys);
-    else
-      detail::NarrowKeyVector().swap(mKeys.narrowKeys);
+    // 4 bytes a key where they fit, until spilling starts. A frame that spilled before kept
+    // 8-byte keys, which the plan does not count beside the narrow ones: setNarrow frees them.
+    mKeys.setNarrow(grid.narrowKeys());
     mBatch.sortRuns = false;  // the spill files take its keys in any order
   }
 
@@ -199,8 +195,7 @@ class FrameBinner {
         mSpill->add(mBatch.cellKeys.data(), nullptr, mBatch.cellKeys.size());
       }
       mBatch.clear();
-      detail::NarrowKeyVector().swap(mKeys.narrowKeys);
-      mKeys.narrow = false;
+      mKeys.setNarrow(false);
     } else {
       mSpill->add(mKeys.cellKeys.data(), mKeys.values.data(), mKeys.cellKeys.size());
     }
