@@ -68,6 +68,10 @@ class InputFile {
   std::uint64_t offset() const { return mOffset; }
   /// Throws FileError past the end.
   void seek(std::uint64_t offset);
+  /// Reads of at least this many bytes go around the buffer: what the buffer holds of one is
+  /// copied, the rest read from the source straight into `data`.
+  static constexpr std::size_t kLargeReadBytes = std::size_t(1) << 20;
+
   /// Reads up to `bytes` bytes; returns how many were read (fewer only at the end of the file).
   /// Throws FileError on an I/O error.
   std::size_t read(void* data, std::size_t bytes);
