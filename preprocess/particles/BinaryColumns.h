@@ -40,15 +40,15 @@ inline constexpr std::size_t kRecordBatchBytes = InputFile::kLargeReadBytes;
 
 /// Reads `count` records of `stride` (> 0) bytes from where `file` stands, the fewest that make
 /// kRecordBatchBytes (at least one) at a time into `buffer`, and calls decode(records, n, first)
-/// for each batch of n records, the first of them record `first` of the `count`. A whole batch
-/// is a large read of `file` (InputFile::kLargeReadBytes): read from its source straight into
-/// `buffer`, not through the file's own buffer. Leaves `file` just after the last record. Where
+/// for each batch of n records, the first of them record `first` of the `count`. A batch of that
+/// size is a large read of `file` (InputFile::kLargeReadBytes): what the file's buffer does not
+/// hold of it is read from its source straight into `buffer`. Leaves `file` just after the last record. Where
 /// the file ends inside record i (of the `count`), throws what truncated(i) returns, the records
 /// before i's batch decoded.
 template <class Decode, class Truncated>
 void readRecordBatches(InputFile& file, std::size_t stride, std::size_t count, std::vector<std::byte>& buffer,
                        const Decode& decode, const Truncated& truncated) {
-  const std::size_t batch = (kRecordBatchBytes + stride - 1) / stride;
+  const std::size_t batch = 1 + (kRecordBatchBytes - 1) / stride;  // rounded up, without overflow
   for (std::size_t first = 0; first < count; first += batch) {
     const std::size_t n = std::min(batch, count - first);
     buffer.resize(n * stride);

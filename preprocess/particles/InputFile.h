@@ -1,7 +1,7 @@
-// InputFile: a read-only byte stream for the particle readers, read through a 1 MiB buffer,
-// from a file, from bytes in memory (fuzz targets, tests) or from a decoder layered over
-// another InputFile (gzip, Houdini's scf1 container: see ByteSource). Tracks the byte offset
-// for error messages. Not thread safe.
+// InputFile: a read-only byte stream for the particle readers, read through a 1 MiB buffer
+// (large reads go around it), from a file, from bytes in memory (fuzz targets, tests) or from a
+// decoder layered over another InputFile (gzip, Houdini's scf1 container: see ByteSource).
+// Tracks the byte offset for error messages. Not thread safe.
 #pragma once
 
 #include <cstddef>

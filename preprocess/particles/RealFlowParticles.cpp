@@ -19,9 +19,9 @@
 // others 6, RealFlow itself 10), so it is checked as far as it is understood and taken on trust
 // beyond (additional data, internal data that is not empty).
 //
-// The records are read in chunks, 1 MiB of records at a time, decoded while they are in cache
-// (memory: the chunk and that 1 MiB); the trailing section is checked once the last particle has
-// been read.
+// The records are read in chunks, about 1 MiB of records at a time (readRecordBatches), decoded
+// while they are in cache (memory: the chunk and that batch); the trailing section is checked once the last particle
+// has been read.
 #include <algorithm>
 #include <bit>
 #include <cstring>

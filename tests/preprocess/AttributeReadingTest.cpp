@@ -166,9 +166,9 @@ TEST(PlyAttributes, ColumnsHoldTheValuesWrittenInEveryEncoding) {
   }
 }
 
-// Binary records are read a megabyte at a time (PlyParticles.cpp, kBinarySliceBytes): a chunk of
-// 60000 records of 43 bytes spans three slices, the last one short. Every value lands at its own
-// particle, and a file cut inside the third slice says where it ends.
+// Binary records are read about a megabyte at a time (readRecordBatches: 24386 records of 43
+// bytes, the fewest that make 1 MiB): a chunk of 60000 spans three slices, the last one short. Every value lands at its
+// own particle, and a file cut inside the third slice says where it ends.
 TEST(PlyAttributes, AChunkOfSeveralReadSlicesKeepsEveryRecordInPlace) {
   TempDir dir("ply-slices");
   const auto rows = plyRows(60000);
@@ -191,7 +191,7 @@ TEST(PlyAttributes, AChunkOfSeveralReadSlicesKeepsEveryRecordInPlace) {
   }
   EXPECT_FALSE(source->read(chunk, rows.size()));
   const std::size_t header = bytes.size() - rows.size() * 43;
-  const std::size_t whole = 55000;  // in the third slice (records 48770 on)
+  const std::size_t whole = 55000;  // in the third slice (records 48772 on)
   writeBytes(path, bytes.substr(0, header + whole * 43 + 20));
   expectFileError([&] { openParticleFile(path, options)->read(chunk, rows.size()); },
                   {"slices.ply", "file ends at particle " + std::to_string(whole) + " of 60000"});

@@ -170,10 +170,10 @@ TEST(InputFile, AFileReadOnceStreamsItsReadsInOrderAndReadsAnythingElseThroughTh
       EXPECT_EQ(got, std::min<std::uint64_t>(bytes, size - at)) << "at " << at;
       EXPECT_EQ(firstWrongByte(data, at, got), -1) << "at " << at;
     };
-    expectRead(100);           // InputFile's buffer fills 1 MiB at the start: the stream starts
-    expectRead(2 * kMiB + 3);  // the rest of the buffer, then a large read from the stream
+    expectRead(100);           // InputFile's buffer fills 64 KiB at the start, through the cache
+    expectRead(2 * kMiB + 3);  // the rest of the buffer, then a large read: the stream starts
     expectRead(3 * kMiB);
-    input.seek(12345);  // back: from the buffer, then a fill that does not continue the last read
+    input.seek(12345);  // back: from the buffer, then the rest through the cache (too short for a stream)
     expectRead(kMiB);
     expectRead(kMiB + 1);  // a large read that continues the last: a new stream
     std::vector<std::byte> small(64);  // a read elsewhere in between, through the cache
