@@ -29,6 +29,7 @@
 #include "core/Error.h"
 #include "core/FastFloor.h"
 #include "core/Morton.h"
+#include "preprocess/CellValueSort.h"
 
 namespace flipscope::detail {
 
@@ -316,34 +317,6 @@ std::uint16_t quantizeAttribute(float s, float min, float max) {
   // exact for 0 < x < 2^23.
   const float x = t * 65535.0f, whole = std::floor(x);
   return std::uint16_t(std::uint16_t(whole) + (x - whole >= 0.5f ? 1 : 0));
-}
-
-namespace {
-
-/// Sorts the `count` values of one cell of at most Lanes: each value goes to its rank among
-/// them, counted over Lanes slots without a branch (ties broken by position, the padding above
-/// every value). A cell holds a few random values, which cost an insertion sort a mispredicted
-/// branch each: the rank sort took 20 M values in 5-value cells from 0.196 to 0.081 s here.
-template <std::uint32_t Lanes>
-void rankSort(std::uint16_t* values, std::uint32_t count) {
-  constexpr std::uint32_t kIndexBits = std::bit_width(Lanes - 1);
-  alignas(64) std::array<std::uint32_t, Lanes> tagged;
-  for (std::uint32_t i = 0; i < Lanes; ++i)
-    tagged[i] = i < count ? (std::uint32_t(values[i]) << kIndexBits) | i : std::numeric_limits<std::uint32_t>::max();
-  for (std::uint32_t i = 0; i < count; ++i) {
-    std::uint32_t rank = 0;
-    for (std::uint32_t j = 0; j < Lanes; ++j) rank += tagged[j] < tagged[i];
-    values[rank] = std::uint16_t(tagged[i] >> kIndexBits);
-  }
-}
-
-}  // namespace
-
-void sortCellValues(std::uint16_t* values, std::uint32_t count) {
-  if (count <= 1) return;
-  if (count <= 8) return rankSort<8>(values, count);
-  if (count <= 16) return rankSort<16>(values, count);
-  std::sort(values, values + count);
 }
 
 namespace {

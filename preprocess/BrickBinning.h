@@ -172,10 +172,6 @@ KeyTally computeKeys(const ParticleChunk& chunk, const KeyGrid& grid, KeyBatch& 
 /// Quantizes value s into [0, 65535] over [min, max] (NaN and -inf: 0, +inf: 65535).
 std::uint16_t quantizeAttribute(float s, float min, float max);
 
-/// Sorts one cell's `count` attribute values in place, ascending: the order in which a brick
-/// stores a cell's values, whatever order its particles came in.
-void sortCellValues(std::uint16_t* values, std::uint32_t count);
-
 /// The full 64-bit key of a cell key (kind included) and its quantized attribute: without kinds
 /// [cell key][attribute]; with `kinds` [cell key][attribute / 4, 14 bits][kind].
 inline std::uint64_t binningKey(std::uint64_t cellKey, std::uint16_t attribute, bool kinds) {

@@ -305,22 +305,5 @@ TEST(StoreHeaderAttribute, NameAndRangeRoundTripAndAreChecked) {
   EXPECT_THROW(parseStoreHeader(serializeStoreHeader(h, frames, AttributeRange{2.0f, 1.0f}), "store.fsh"), FileError);
 }
 
-TEST(ConvertAttribute, ACellsValuesAreSortedWhateverTheirCountAndTies) {
-  // Every count up to past the largest rank sort (16), with ties and both ends of the range.
-  std::mt19937 rng(5);
-  for (std::uint32_t count = 0; count <= 40; ++count) {
-    for (int trial = 0; trial < 50; ++trial) {
-      std::vector<std::uint16_t> values(count);
-      for (auto& v : values)
-        v = trial % 3 == 0 ? std::uint16_t(rng() % 3 ? 65535 : 0)
-                           : std::uint16_t(trial % 3 == 1 ? rng() : rng() % 7 * 9000);
-      std::vector<std::uint16_t> expected = values;
-      std::sort(expected.begin(), expected.end());
-      detail::sortCellValues(values.data(), count);
-      ASSERT_EQ(values, expected) << count << " values, trial " << trial;
-    }
-  }
-}
-
 }  // namespace
 }  // namespace flipscope

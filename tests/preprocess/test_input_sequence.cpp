@@ -9,7 +9,7 @@ namespace {
 
 using testing::TempDir;
 
-void touch(const std::filesystem::path& path) { testing::writeBytes(path, "x"); }
+void createFile(const std::filesystem::path& path) { testing::writeBytes(path, "x"); }
 
 TEST(InputSequence, SubstitutesEveryPatternKind) {
   EXPECT_EQ(substituteFrame("a/fluid_####.vdb", 7), "a/fluid_0007.vdb");
@@ -46,10 +46,10 @@ TEST(InputSequence, ParsesFrameRanges) {
 
 TEST(InputSequence, DiscoversFramesInTheDirectory) {
   TempDir dir("seq-discover");
-  for (int f : {12, 3, 100, 7}) touch(dir / substituteFrame("fluid_####.vdb", f));
-  touch(dir / "fluid_12.vdb");    // wrong width: not frame 12 of ####
-  touch(dir / "fluid_0x12.vdb");  // not a number
-  touch(dir / "other_0005.vdb");
+  for (int f : {12, 3, 100, 7}) createFile(dir / substituteFrame("fluid_####.vdb", f));
+  createFile(dir / "fluid_12.vdb");    // wrong width: not frame 12 of ####
+  createFile(dir / "fluid_0x12.vdb");  // not a number
+  createFile(dir / "other_0005.vdb");
   for (std::string pattern : {"fluid_####.vdb", "fluid_%04d.vdb"}) {
     auto frames = expandInputs({(dir / pattern).string()}, std::nullopt);
     ASSERT_EQ(frames.size(), 4u) << pattern;
@@ -61,9 +61,9 @@ TEST(InputSequence, DiscoversFramesInTheDirectory) {
     }
     EXPECT_EQ(numbers, (std::vector<int>{3, 7, 12, 100}));
   }
-  touch(dir / "splash.0001.bgeo.sc");
-  touch(dir / "splash.0002.bgeo.sc");
-  touch(dir / "splash.0002.bgeo");  // another extension: not a frame of the .bgeo.sc pattern
+  createFile(dir / "splash.0001.bgeo.sc");
+  createFile(dir / "splash.0002.bgeo.sc");
+  createFile(dir / "splash.0002.bgeo");  // another extension: not a frame of the .bgeo.sc pattern
   auto houdini = expandInputs({(dir / "splash.$F4.bgeo.sc").string()}, std::nullopt);
   ASSERT_EQ(houdini.size(), 2u);
   EXPECT_EQ(houdini[1].frame, 2);
@@ -79,12 +79,12 @@ TEST(InputSequence, ADirectoryGivenAsInputNamesTheSequencesItHolds) {
   TempDir dir("seq-folder");
   std::filesystem::create_directories(dir / "cache" / "data");
   std::filesystem::create_directories(dir / "cache" / "particles");
-  for (int f : {1, 2, 10}) touch(dir / "cache" / "data" / substituteFrame("fluid_data_####.vdb", f));
-  touch(dir / "cache" / "particles" / "fluid_particles_0001.vdb");
-  touch(dir / "cache" / "splash.1.bgeo.sc");
-  touch(dir / "cache" / "splash.12.bgeo.sc");  // unpadded: one '#'
-  touch(dir / "cache" / "notes_01.txt");       // not a particle file
-  touch(dir / "cache" / "fluid.vdb");          // not numbered
+  for (int f : {1, 2, 10}) createFile(dir / "cache" / "data" / substituteFrame("fluid_data_####.vdb", f));
+  createFile(dir / "cache" / "particles" / "fluid_particles_0001.vdb");
+  createFile(dir / "cache" / "splash.1.bgeo.sc");
+  createFile(dir / "cache" / "splash.12.bgeo.sc");  // unpadded: one '#'
+  createFile(dir / "cache" / "notes_01.txt");       // not a particle file
+  createFile(dir / "cache" / "fluid.vdb");          // not numbered
   const std::string cache = (dir / "cache").string();
   testing::expectFileError(
       [&] { expandInputs({cache}, std::nullopt); },
@@ -105,8 +105,8 @@ TEST(InputSequence, ADirectoryGivenAsInputNamesTheSequencesItHolds) {
 TEST(InputSequence, FrameRangeAndTwoInputsPerFrame) {
   TempDir dir("seq-range");
   for (int f = 1; f <= 5; ++f) {
-    touch(dir / substituteFrame("data_####.vdb", f));
-    touch(dir / substituteFrame("spray_{}.vdb", f));
+    createFile(dir / substituteFrame("data_####.vdb", f));
+    createFile(dir / substituteFrame("spray_{}.vdb", f));
   }
   auto frames =
       expandInputs({(dir / "data_####.vdb").string(), (dir / "spray_{}.vdb").string()}, parseFrameRange("2-4"));
@@ -123,8 +123,8 @@ TEST(InputSequence, FrameRangeAndTwoInputsPerFrame) {
 
 TEST(InputSequence, MissingFileNamesPathAndFrame) {
   TempDir dir("seq-missing");
-  for (int f = 1; f <= 4; ++f) touch(dir / substituteFrame("data_####.vdb", f));
-  for (int f : {1, 2, 4}) touch(dir / substituteFrame("spray_%d.vdb", f));
+  for (int f = 1; f <= 4; ++f) createFile(dir / substituteFrame("data_####.vdb", f));
+  for (int f : {1, 2, 4}) createFile(dir / substituteFrame("spray_%d.vdb", f));
   auto inputs = std::vector<std::string>{(dir / "data_####.vdb").string(), (dir / "spray_%d.vdb").string()};
   testing::expectFileError([&] { expandInputs(inputs, std::nullopt); }, {"spray_3.vdb", "frame 3", "spray_%d.vdb"});
   testing::expectFileError([&] { expandInputs(inputs, parseFrameRange("4-6")); }, {"data_0005.vdb", "frame 5"});
@@ -133,8 +133,8 @@ TEST(InputSequence, MissingFileNamesPathAndFrame) {
 
 TEST(InputSequence, InputsWithoutPatternFormOneFrame) {
   TempDir dir("seq-single");
-  touch(dir / "a.ply");
-  touch(dir / "b.bin");
+  createFile(dir / "a.ply");
+  createFile(dir / "b.bin");
   auto frames = expandInputs({(dir / "a.ply").string(), (dir / "b.bin").string()}, std::nullopt);
   ASSERT_EQ(frames.size(), 1u);
   EXPECT_EQ(frames[0].frame, 0);
