@@ -1,7 +1,9 @@
 // CellValueSort: the sort of one cell's quantized attribute values, ascending: the order in which
-// a brick stores them in its attribute buffer, cell after cell (Reichl et al. 2014 §3.2). A cell
-// holds a few values (about eight where particles lie half a cell apart), so the sort is a
-// network in one or two SIMD registers, not a comparison sort's mispredicted branches.
+// a brick stores them, cell after cell (store/BrickCodec.cpp; Reichl et al. 2014 §3.2 keep one
+// value a cell, we keep every particle's). A cell holds a few values (about eight where particles
+// lie half a cell apart), so on x86-64-v2 builds (the default) up to 16 are sorted by a network
+// in one or two SSE registers, not a comparison sort's mispredicted branches; elsewhere, and past
+// 16, by std::sort.
 #pragma once
 
 #include <cstdint>
