@@ -42,9 +42,9 @@ inline constexpr std::size_t kRecordBatchBytes = InputFile::kLargeReadBytes;
 /// kRecordBatchBytes (at least one) at a time into `buffer`, and calls decode(records, n, first)
 /// for each batch of n records, the first of them record `first` of the `count`. A batch of that
 /// size is a large read of `file` (InputFile::kLargeReadBytes): what the file's buffer does not
-/// hold of it is read from its source straight into `buffer`. Leaves `file` just after the last record. Where
-/// the file ends inside record i (of the `count`), throws what truncated(i) returns, the records
-/// before i's batch decoded.
+/// hold of it is read from its source straight into `buffer`. Leaves `file` just after the last
+/// record. Where the file ends inside record i (of the `count`), throws what truncated(i)
+/// returns, the records before i's batch decoded.
 template <class Decode, class Truncated>
 void readRecordBatches(InputFile& file, std::size_t stride, std::size_t count, std::vector<std::byte>& buffer,
                        const Decode& decode, const Truncated& truncated) {

@@ -356,8 +356,9 @@ class PlyReader final : public ParticleSource {
   /// Binary records in one read of kRecordBatchBytes (at least one).
   std::size_t recordsPerSlice() const { return std::max<std::size_t>(1, kRecordBatchBytes / mHeader.vertexBytes); }
 
-  /// About a megabyte of records at a time (readRecordBatches): the reader holds that, not a chunk's
-  /// records (24 MB for a million particles of six floats), and the split reads them from the cache.
+  /// About a megabyte of records at a time (readRecordBatches): the reader holds that, not a
+  /// chunk's records (24 MB for a million particles of six floats), and the split reads them from
+  /// the cache.
   void readBinary(ParticleChunk& chunk, std::uint64_t n) {
     const std::size_t stride = mHeader.vertexBytes;
     readRecordBatches(

@@ -20,8 +20,8 @@
 // beyond (additional data, internal data that is not empty).
 //
 // The records are read in chunks, about 1 MiB of records at a time (readRecordBatches), decoded
-// while they are in cache (memory: the chunk and that batch); the trailing section is checked once the last particle
-// has been read.
+// while they are in cache (memory: the chunk and that batch); the trailing section is checked
+// once the last particle has been read.
 #include <algorithm>
 #include <bit>
 #include <cstring>

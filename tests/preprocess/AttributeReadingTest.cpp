@@ -167,8 +167,8 @@ TEST(PlyAttributes, ColumnsHoldTheValuesWrittenInEveryEncoding) {
 }
 
 // Binary records are read about a megabyte at a time (readRecordBatches: 24386 records of 43
-// bytes, the fewest that make 1 MiB): a chunk of 60000 spans three slices, the last one short. Every value lands at its
-// own particle, and a file cut inside the third slice says where it ends.
+// bytes, the fewest that make 1 MiB): a chunk of 60000 spans three slices, the last one short.
+// Every value lands at its own particle, and a file cut inside the third slice says where it ends.
 TEST(PlyAttributes, AChunkOfSeveralReadSlicesKeepsEveryRecordInPlace) {
   TempDir dir("ply-slices");
   const auto rows = plyRows(60000);

@@ -3,12 +3,12 @@
 // strings are a var16 length (an int16, or -1 and an int32) and their bytes.
 //
 // The points are read in chunks, about 1 MiB of records at a time (readRecordBatches), decoded
-// while they are in cache (memory: the chunk and that batch). What follows them is checked once the last point has been
-// read: the vertex and primitive dictionaries, the primitives (particle systems, "Part", are
-// walked and their point indices checked), the detail attributes and the extra section, which
-// ends the file with 00 ff. Where the file holds something this reader cannot walk (other
-// primitive types, groups, unknown attribute types after the points), the rest is taken on
-// trust, except that the file must still end with the end marker 0xff.
+// while they are in cache (memory: the chunk and that batch). What follows them is checked once
+// the last point has been read: the vertex and primitive dictionaries, the primitives (particle
+// systems, "Part", are walked and their point indices checked), the detail attributes and the
+// extra section, which ends the file with 00 ff. Where the file holds something this reader
+// cannot walk (other primitive types, groups, unknown attribute types after the points), the
+// rest is taken on trust, except that the file must still end with the end marker 0xff.
 #include "preprocess/particles/houdini/ClassicBgeo.h"
 
 #include <algorithm>
