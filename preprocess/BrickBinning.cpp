@@ -30,6 +30,7 @@
 #include "core/FastFloor.h"
 #include "core/Morton.h"
 #include "preprocess/CellValueSort.h"
+#include "preprocess/GridCells.h"
 
 namespace flipscope::detail {
 
@@ -218,6 +219,9 @@ KeyTally computeKeysInto(const ParticleChunk& chunk, const KeyGrid& grid, KeyBat
                           grid.codeBits <= kBlockSplitCodeBits && gridBricks(grid) * kKeysPerRun <= kBlock;
   const std::uint32_t codeShift = grid.cellKeyShift() + grid.cellBits;
   std::vector<std::vector<CodedRun>> blockRuns(sortBlocks ? tallies.size() : 0);
+  FLIPSCOPE_CHECK((!std::is_same_v<Key, std::uint32_t>) || (!attribute && !types && !separateValues),
+                  "narrow keys carry neither an attribute nor kinds");
+  const GridCells gridCells(grid.header.origin, grid.invCellSize, grid.cells, grid.clip);
   tbb::parallel_for(std::size_t(0), tallies.size(), [&](std::size_t b) {
     // The loop's inputs as the task's locals, not the grid's members nor the closure's
     // references: the compiler need not load them again (twice, through a reference) after
@@ -230,44 +234,55 @@ KeyTally computeKeysInto(const ParticleChunk& chunk, const KeyGrid& grid, KeyBat
                         *keysZ = grid.axisKeys[2].data();
     Key* const keyOut = keys;
     float* const valueOut = values;
-    const glm::dvec3 origin = grid.header.origin, limit(grid.cells);
-    const double inverseCell = grid.invCellSize;
-    const bool clipped = grid.clip.has_value();
-    const Box clip = grid.clip.value_or(Box{});
+    const GridCells cellsOf = gridCells;
     const bool valueInKey = grid.valueInKey, withAttribute = attribute;
     Tally t;
     const std::size_t begin = b * kBlock, end = std::min(n, begin + kBlock);
     std::size_t to = begin;
-    for (std::size_t i = begin; i != end; ++i) {
-      const glm::vec3 p = positions[i];
-      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-        ++t.invalid;
-        continue;
-      }
-      const glm::dvec3 q(p);
-      const glm::dvec3 c = fastFloor((q - origin) * inverseCell);
-      if ((clipped && !clip.contains(q)) || c.x < 0 || c.y < 0 || c.z < 0 || c.x >= limit.x || c.y >= limit.y ||
-          c.z >= limit.z) {
-        ++t.outside;
-        continue;
-      }
-      const glm::uvec3 cell(c);
-      const std::uint64_t cellKey = keysX[cell.x] | keysY[cell.y] | keysZ[cell.z];
-      const std::uint64_t particleKind = typeValues ? std::uint64_t(kindOfTypeValue(typeValues[i])) : 0;
-      const float s = velocities ? glm::length(velocities[i]) : withAttribute ? attributeValue(chunk, kind, i) : 0.0f;
-      if (withAttribute && std::isfinite(s)) {
-        t.valueMin = std::min(t.valueMin, s);
-        t.valueMax = std::max(t.valueMax, s);
-      }
-      // A narrow Key holds every bit the grid's keys may set (KeyGrid::narrowKeys).
-      if (valueInKey) {
-        keyOut[to] = Key((((particleKind << kPackedCellBits) | cellKey) << 32) | std::bit_cast<std::uint32_t>(s));
+    // Particle i, in `cell`, kept.
+    const auto keep = [&](std::size_t i, std::uint32_t cellX, std::uint32_t cellY, std::uint32_t cellZ) {
+      const std::uint64_t cellKey = keysX[cellX] | keysY[cellY] | keysZ[cellZ];
+      if constexpr (std::is_same_v<Key, std::uint32_t>) {
+        keyOut[to] = Key(cellKey);  // narrow: no attribute, no kinds (KeyGrid::narrowKeys)
       } else {
-        keyOut[to] = Key((particleKind << kKindShift) | cellKey);
-        if (valueOut) valueOut[to] = s;
+        const std::uint64_t particleKind = typeValues ? std::uint64_t(kindOfTypeValue(typeValues[i])) : 0;
+        const float s = velocities ? glm::length(velocities[i]) : withAttribute ? attributeValue(chunk, kind, i) : 0.0f;
+        if (withAttribute && std::isfinite(s)) {
+          t.valueMin = std::min(t.valueMin, s);
+          t.valueMax = std::max(t.valueMax, s);
+        }
+        if (valueInKey) {
+          keyOut[to] = Key((((particleKind << kPackedCellBits) | cellKey) << 32) | std::bit_cast<std::uint32_t>(s));
+        } else {
+          keyOut[to] = Key((particleKind << kKindShift) | cellKey);
+          if (valueOut) valueOut[to] = s;
+        }
       }
       ++to;
+    };
+    // Particle i on its own: kept, or counted as invalid or outside.
+    const auto sortOut = [&](std::size_t i) {
+      const glm::vec3 p = positions[i];
+      glm::uvec3 cell;
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+        ++t.invalid;
+      } else if (!cellsOf.one(p, cell)) {  // outside the grid or the clip box
+        ++t.outside;
+      } else {
+        keep(i, cell.x, cell.y, cell.z);
+      }
+    };
+    // Four at a time; a four with a particle that is not kept, one at a time.
+    std::size_t i = begin;
+    CellsOfFour four;
+    for (; i + 4 <= end; i += 4) {
+      if (cellsOf.four(positions + i, four)) {
+        for (int k = 0; k < 4; ++k) keep(i + std::size_t(k), four.x[k], four.y[k], four.z[k]);
+      } else {
+        for (std::size_t k = 0; k < 4; ++k) sortOut(i + k);
+      }
     }
+    for (; i < end; ++i) sortOut(i);
     t.kept = to - begin;
     tallies[b] = t;
     if (sortBlocks) sortBlockByBrick(keys + begin, t.kept, 0, codeShift, grid.codeBits, blockRuns[b]);
