@@ -157,9 +157,10 @@ struct PeerComparison {
                 gib(std::max(convertPeakBytes, flipscope.peakBytes)));
     std::printf("  %-34s %16.2f %16.2f %14s %14.2f\n", "  the same, --particle-spacing given", givenConvertSeconds,
                 givenFirst(), "", gib(std::max(givenConvertPeakBytes, given.peakBytes)));
-    std::printf("  (prepare: Embree's BVH build, flipscope's convert; flipscope's warm frames are the ray-caster's "
-                "spheres, %.1f ms of it tracing)\n",
-                flipscope.warmTraceMeanMs());
+    std::printf(
+        "  (prepare: Embree's BVH build, flipscope's convert; flipscope's warm frames are the ray-caster's "
+        "spheres, %.1f ms of it tracing)\n",
+        flipscope.warmTraceMeanMs());
     if (!embree) return;
     std::printf("  target: a warm frame no slower than Embree's: %s (%.2fx)\n",
                 warmMet(warmRatio()) ? "met" : "NOT met", warmRatio());
@@ -179,17 +180,17 @@ struct PeerComparison {
 
 /// The Embree peer beside flipscope on `device`: the bench's --device when it names a CPU
 /// ray-caster (cpu or cpu-reference), else cpu, since Embree runs on the CPU.
-PeerComparison compareWithEmbree(const fs::path& work, const fs::path& particles, double cellSize,
-                                 const Camera& camera, const std::string& size, int orbitFrames,
-                                 const std::string& device) {
+PeerComparison compareWithEmbree(const fs::path& work, const fs::path& particles, double cellSize, const Camera& camera,
+                                 const std::string& size, int orbitFrames, const std::string& device) {
   PeerComparison c;
   c.size = size;
   const fs::path store = work / "peer.store", cameraFile = work / "peer_camera.json";
   saveCamera(cameraFile, camera);
   fs::remove_all(store);
   const std::string cell = exactNumberText(cellSize);
-  const ChildRun convert = runFlipscopeStage(
-      "peer's convert", {"convert", particles.string(), "-o", store.string(), "--cell-size", cell}, work / "peer_convert.log");
+  const ChildRun convert =
+      runFlipscopeStage("peer's convert", {"convert", particles.string(), "-o", store.string(), "--cell-size", cell},
+                        work / "peer_convert.log");
   c.convertSeconds = convert.seconds;
   c.convertPeakBytes = convert.peakBytes;
   FrameStageRequest frame;
@@ -220,26 +221,11 @@ PeerComparison compareWithEmbree(const fs::path& work, const fs::path& particles
 }
 
 /// Over the runs of the peer comparison (with Embree): each target's ratio per run, its median
-/// and range, and in how many runs it was met. On a machine whose times swing from run to run,
-/// the spread says more than one run.
+/// and range, and in how many runs it was met.
 struct PeerSummary {
-  struct Ratio {
-    std::vector<double> perRun;
-    int met = 0;
-    double median() const { return tools::median(perRun); }
-    double min() const { return *std::min_element(perRun.begin(), perRun.end()); }
-    double max() const { return *std::max_element(perRun.begin(), perRun.end()); }
-    void add(double ratio, bool metTarget) {
-      perRun.push_back(ratio);
-      met += metTarget;
-    }
-    nlohmann::json json() const {
-      return {{"per_run", perRun}, {"median", median()}, {"min", min()}, {"max", max()}, {"met_runs", met}};
-    }
-  };
-  Ratio warm;         ///< PeerComparison::warmRatio
-  Ratio sooner;       ///< PeerComparison::soonerRatio
-  Ratio givenSooner;  ///< PeerComparison::givenSoonerRatio
+  RunRatios warm;         ///< PeerComparison::warmRatio
+  RunRatios sooner;       ///< PeerComparison::soonerRatio
+  RunRatios givenSooner;  ///< PeerComparison::givenSoonerRatio
 
   /// nullopt when Embree is not built in.
   static std::optional<PeerSummary> of(const std::vector<PeerComparison>& peers) {
@@ -261,7 +247,7 @@ struct PeerSummary {
   void print() const {
     const std::size_t n = warm.perRun.size();
     std::printf("\npeer over %zu runs: median, range, runs that met the target\n", n);
-    const auto row = [n](const std::string& what, const Ratio& r, int decimals) {
+    const auto row = [n](const std::string& what, const RunRatios& r, int decimals) {
       std::printf("  %-62s %6.*fx %6.*fx to %.*fx %3d of %zu\n", what.c_str(), decimals, r.median(), decimals, r.min(),
                   decimals, r.max(), r.met, n);
     };
@@ -348,7 +334,8 @@ void runBenchRender(const BenchRenderArgs& a) {
   foamSettings.height = sizes.back().second;
   foamSettings.gpuBudgetBytes = parseBytes("--gpu-mem", a.gpuMem);
   foamSettings.radius = defaultSphereRadius(BrickStore::open(storeDir).header(), foamSettings.jitter);
-  if (!a.json) std::fprintf(stderr, "bench render: foam and absorption at %ux%u ...\n", foamSettings.width, foamSettings.height);
+  if (!a.json)
+    std::fprintf(stderr, "bench render: foam and absorption at %ux%u ...\n", foamSettings.width, foamSettings.height);
   const FoamTraceTiming foam = timeFoamAndAbsorption(storeDir, choice, foamSettings, lastCamera, a.orbitFrames);
 
   std::optional<double> vdbTool;
@@ -376,13 +363,14 @@ void runBenchRender(const BenchRenderArgs& a) {
                      {"first_image_s", main.firstImageSeconds},
                      {"frame_ms", main.frameMs},
                      {"vdb_tool_s", vdbTool ? nlohmann::json(*vdbTool) : nlohmann::json(nullptr)},
-                     {"foam", {{"trace_spheres_ms", foam.spheresMs},
-                               {"trace_absorption_ms", foam.absorptionMs},
-                               {"trace_remove_ms", foam.removeMs},
-                               {"trace_volume_ms", foam.volumeMs},
-                               {"absorption_ms", foam.absorptionCost()},
-                               {"volumetric_foam_ms", foam.volumeCost()},
-                               {"classification_ms", foam.classifyMs}}}};
+                     {"foam",
+                      {{"trace_spheres_ms", foam.spheresMs},
+                       {"trace_absorption_ms", foam.absorptionMs},
+                       {"trace_remove_ms", foam.removeMs},
+                       {"trace_volume_ms", foam.volumeMs},
+                       {"absorption_ms", foam.absorptionCost()},
+                       {"volumetric_foam_ms", foam.volumeCost()},
+                       {"classification_ms", foam.classifyMs}}}};
     for (const SizeResult& r : results)
       j["sizes"].push_back({{"width", r.width},
                             {"height", r.height},
@@ -407,10 +395,11 @@ void runBenchRender(const BenchRenderArgs& a) {
     std::printf("%5ux%-5u %14.3f %8d %10llu %12.0f %14.1f %14.1f\n", r.width, r.height, r.firstImageSeconds,
                 r.cold.passes, (unsigned long long)r.cold.bricksUploaded, r.cold.streamMs, r.frameMs, r.traceMs);
   std::printf("%-11s %14s %8s %10s %12s %14s %14s\n", "paper", "-", "-", "-", "-", "8.5-50 (GPU)", "");
-  std::printf("\nfoam and absorption at %ux%u, warm trace ms (median of %d frames, the variants in turn), %s:\n", main.width, main.height,
-              a.orbitFrames, foam.device.c_str());
+  std::printf("\nfoam and absorption at %ux%u, warm trace ms (median of %d frames, the variants in turn), %s:\n",
+              main.width, main.height, a.orbitFrames, foam.device.c_str());
   std::printf("  %-44s %10s %10s %18s\n", "", "trace ms", "added ms", "paper (GTX Titan)");
-  std::printf("  %-44s %10.1f %10s %18s\n", "spheres (--foam keep, no thickness)", foam.spheresMs, "-", "20-27 (Sphere)");
+  std::printf("  %-44s %10.1f %10s %18s\n", "spheres (--foam keep, no thickness)", foam.spheresMs, "-",
+              "20-27 (Sphere)");
   std::printf("  %-44s %10.1f %+10.1f %18s\n", "+ absorption (density trace, §3.6)", foam.absorptionMs,
               foam.absorptionCost(), "12-14 (Trans)");
   std::printf("  %-44s %10.1f %+10.1f %18s\n", "+ foam cells skipped (--foam remove)", foam.removeMs,
