@@ -27,7 +27,6 @@
 #include <glm/geometric.hpp>
 
 #include "core/Error.h"
-#include "core/FastFloor.h"
 #include "core/Morton.h"
 #include "preprocess/CellValueSort.h"
 #include "preprocess/GridCells.h"
@@ -219,8 +218,6 @@ KeyTally computeKeysInto(const ParticleChunk& chunk, const KeyGrid& grid, KeyBat
                           grid.codeBits <= kBlockSplitCodeBits && gridBricks(grid) * kKeysPerRun <= kBlock;
   const std::uint32_t codeShift = grid.cellKeyShift() + grid.cellBits;
   std::vector<std::vector<CodedRun>> blockRuns(sortBlocks ? tallies.size() : 0);
-  FLIPSCOPE_CHECK((!std::is_same_v<Key, std::uint32_t>) || (!attribute && !types && !separateValues),
-                  "narrow keys carry neither an attribute nor kinds");
   const GridCells gridCells(grid.header.origin, grid.invCellSize, grid.cells, grid.clip);
   tbb::parallel_for(std::size_t(0), tallies.size(), [&](std::size_t b) {
     // The loop's inputs as the task's locals, not the grid's members nor the closure's
@@ -277,7 +274,7 @@ KeyTally computeKeysInto(const ParticleChunk& chunk, const KeyGrid& grid, KeyBat
     CellsOfFour four;
     for (; i + 4 <= end; i += 4) {
       if (cellsOf.four(positions + i, four)) {
-        for (int k = 0; k < 4; ++k) keep(i + std::size_t(k), four.x[k], four.y[k], four.z[k]);
+        for (std::size_t k = 0; k < 4; ++k) keep(i + k, four.x[k], four.y[k], four.z[k]);
       } else {
         for (std::size_t k = 0; k < 4; ++k) sortOut(i + k);
       }

@@ -1,5 +1,5 @@
 // GridCells: the cell of the binning grid that holds a particle, four particles at a time. A
-// particle's cell is floor((double(p) - origin) / cellSize), in double precision so that the
+// particle's cell is floor((double(p) - origin) * inverseCellSize), in double precision so the
 // store does not depend on the float rounding of the grid's far side (computeKeys,
 // BrickBinning.cpp; Reichl et al. 2014 §3.1 bin particles into the cells of a uniform grid). On
 // x86-64-v2 builds (the default) four particles are converted, floored and bounds-checked in SSE
@@ -63,7 +63,7 @@ class GridCells {
   }
 
   /// The cells of p[0], ..., p[3] in `cells` and true, where all four are finite and inside the
-  /// grid (what one() gives each); else false, `cells` unspecified.
+  /// grid and the clip box (what one() gives each); else false, `cells` unspecified.
   bool four(const glm::vec3* p, CellsOfFour& cells) const {
 #if defined(__SSE4_1__)
     static_assert(sizeof(glm::vec3) == 12, "positions are packed x, y, z");

@@ -1,7 +1,7 @@
 // flipscope bench preprocess: conversion throughput against the raw-read limit and against the
 // disk (the uncached read, then converts in and out of core from a dropped page cache, each
 // also given the spacing and the domain the first convert found, so that it reads the input
-// once), in one run. With --disk-runs N, the comparison against the disk N times, one after
+// once), in one process. With --disk-runs N, the comparison against the disk N times, one after
 // another: on a virtual machine whose disk swings from read to read, each run's converts are
 // held against that run's read, and the medians, ranges and runs that met the target follow.
 // Without inputs, a synth frame (raw float32) is generated first (not timed). The input is
@@ -181,15 +181,15 @@ void runBenchPreprocess(const BenchPreprocessArgs& a) {
       cold.cellSize = report.header.cellSize;
       cold.domain = Box{report.header.origin, report.header.domainMax()};
     }
-    const fs::path name = work / ("store-cold-" + std::to_string(int(c)));
-    fs::remove_all(name);
+    const fs::path coldStore = work / ("store-cold-" + std::to_string(int(c)));
+    fs::remove_all(coldStore);
     ::sync();  // the last run's writes (its store, its spill files) are not this one's to wait for
     dropFromPageCache(files);
     const auto begin = std::chrono::steady_clock::now();
-    const ConvertReport r = convert(inputs, name, cold);
+    const ConvertReport r = convert(inputs, coldStore, cold);
     run.seconds[c] = secondsSince(begin);
     run.spilled[c] = r.frames.front().spillBuckets > 0;
-    fs::remove_all(name);
+    fs::remove_all(coldStore);
   };
   std::vector<DiskRun> diskRuns(std::size_t(a.diskRuns));
   for (std::size_t k = 0; k < diskRuns.size(); ++k) {
@@ -264,20 +264,18 @@ void runBenchPreprocess(const BenchPreprocessArgs& a) {
     std::printf("%-34s %10.3f %16s %12s   %.2fx the disk read\n", coldLabels[c].c_str(), first.seconds[c],
                 Progress::humanCount(particles / first.seconds[c]).c_str(), "", first.ratio(c));
   if (diskRuns.size() > 1) {
-    std::printf("\nagainst the disk over %zu runs, each convert against its run's disk read:\n", diskRuns.size());
+    std::printf(
+        "\nagainst the disk over %zu runs (the rows above are run 1's), each convert against its run's disk "
+        "read:\n",
+        diskRuns.size());
     std::printf("  median, range, runs that met the target (at most %.2fx)\n", kDiskTarget);
     for (const ColdConvert c : {kInCore, kOutOfCore, kOneRead, kOneReadOutOfCore})
       std::printf("  %-40s %6.2fx %6.2fx to %.2fx %3d of %zu\n", coldLabels[c].c_str(), againstDisk[c].median(),
                   againstDisk[c].min(), againstDisk[c].max(), againstDisk[c].met, diskRuns.size());
-    std::printf("  disk reads %.3f s to %.3f s\n",
-                std::min_element(diskRuns.begin(), diskRuns.end(),
-                                 [](const DiskRun& x, const DiskRun& y) { return x.disk().seconds < y.disk().seconds; })
-                    ->disk()
-                    .seconds,
-                std::max_element(diskRuns.begin(), diskRuns.end(),
-                                 [](const DiskRun& x, const DiskRun& y) { return x.disk().seconds < y.disk().seconds; })
-                    ->disk()
-                    .seconds);
+    const auto [fastest, slowest] =
+        std::minmax_element(diskRuns.begin(), diskRuns.end(),
+                            [](const DiskRun& x, const DiskRun& y) { return x.disk().seconds < y.disk().seconds; });
+    std::printf("  disk reads %.3f s to %.3f s\n", fastest->disk().seconds, slowest->disk().seconds);
   }
   std::printf("\ntarget: convert <= 4x raw read (goal 1.5x): %s\n", ratio <= 4 ? "met" : "NOT met");
   const auto met = [&](ColdConvert c) { return againstDisk[c].median() <= kDiskTarget ? "met" : "NOT met"; };

@@ -1,6 +1,7 @@
 // GridCells (preprocess/GridCells.h): four particles' cells, in SSE registers on x86-64-v2
 // builds, are one() of each, bit for bit, and four() fails exactly where one() fails for one of
 // them: non-finite positions, cells past either end of an axis, positions outside the clip box.
+// computeKeys, which takes four at a time, keeps what one() keeps, in order, and counts the rest.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,6 +10,9 @@
 #include <random>
 #include <vector>
 
+#include "core/Error.h"
+#include "preprocess/BrickBinning.h"
+#include "preprocess/Convert.h"
 #include "preprocess/GridCells.h"
 
 namespace flipscope {
@@ -131,6 +135,60 @@ TEST(GridCells, OneIsTheFlooredCellOfTheDoublePosition) {
   ASSERT_TRUE(unclipped.one(glm::vec3(0.95f, 0.0f, 0.0f), cell));
   EXPECT_EQ(cell.x, 9u);
   EXPECT_FALSE(unclipped.one(glm::vec3(1.0f, 0.0f, 0.0f), cell));  // cell 10 of 10
+}
+
+TEST(GridCells, AGridOfNoCellsOrOfTooManyAlongAnAxisIsRefused) {
+  EXPECT_THROW(GridCells(glm::dvec3(0.0), 1.0, glm::u64vec3(0, 4, 4)), LogicError);
+  EXPECT_THROW(GridCells(glm::dvec3(0.0), 1.0, glm::u64vec3(4, 4, std::uint64_t(1) << 31)), LogicError);
+  EXPECT_NO_THROW(GridCells(glm::dvec3(0.0), 1.0, glm::u64vec3(4, (std::uint64_t(1) << 31) - 1, 4)));
+}
+
+TEST(GridCells, ComputeKeysKeepsWhatOneKeepsInOrderWhereverTheSkippedParticlesLie) {
+  // Chunks of 1 to 13 particles, a NaN at one place and a particle outside (the grid, or the clip
+  // box) at another: in a four, in the tail, or both; narrow keys and 8-byte ones.
+  ConvertOptions options;
+  options.cellSize = 0.25;
+  options.brickSize = 32;
+  const StoreHeader header = makeStoreHeader(Box{{0, 0, 0}, {4, 4, 4}}, options, AttributeKind::None);
+  for (const std::optional<Box> clip : {std::optional<Box>(), std::optional<Box>(Box{{0, 0, 0}, {2, 4, 4}})}) {
+    const detail::KeyGrid grid(header, clip);
+    ASSERT_TRUE(grid.narrowKeys());
+    const GridCells cells(header.origin, grid.invCellSize, grid.cells, clip);
+    for (const bool narrow : {true, false}) {
+      for (std::size_t n = 1; n <= 13; ++n) {
+        for (std::size_t nan = 0; nan <= n; ++nan) {  // nan == n: none
+          const std::size_t outside = (nan * 7 + 3) % (n + 1);
+          ParticleChunk chunk;
+          for (std::size_t i = 0; i < n; ++i) chunk.positions.push_back(glm::vec3(0.3f + 0.1f * float(i), 1.1f, 3.9f));
+          if (nan < n) chunk.positions[nan].y = std::nanf("");
+          if (outside < n && outside != nan) chunk.positions[outside].x = clip ? 3.0f : -0.5f;
+          std::vector<std::uint64_t> expected;
+          std::uint64_t invalid = 0, skipped = 0;
+          for (const glm::vec3& p : chunk.positions) {
+            glm::uvec3 cell;
+            if (!std::isfinite(p.y)) {
+              ++invalid;
+            } else if (!cells.one(p, cell)) {
+              ++skipped;
+            } else {
+              expected.push_back(grid.axisKeys[0][cell.x] | grid.axisKeys[1][cell.y] | grid.axisKeys[2][cell.z]);
+            }
+          }
+          detail::KeyBatch batch;
+          batch.sortRuns = false;  // the keys in the particles' order
+          batch.setNarrow(narrow);
+          const detail::KeyTally tally = detail::computeKeys(chunk, grid, batch);
+          std::vector<std::uint64_t> keys;
+          batch.withKeys([&](const auto& v) { keys.assign(v.begin(), v.end()); });
+          EXPECT_EQ(keys, expected) << n << " particles, NaN at " << nan << ", outside at " << outside;
+          EXPECT_EQ(tally.kept, expected.size());
+          EXPECT_EQ(tally.invalid, invalid);
+          EXPECT_EQ(tally.outside, skipped);
+          if (HasFailure()) return;
+        }
+      }
+    }
+  }
 }
 
 }  // namespace
