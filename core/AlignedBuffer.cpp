@@ -4,12 +4,28 @@
 #include <cstdlib>
 #include <new>
 
+#include "core/Error.h"
+#include "core/HugePageAdvice.h"
+
 namespace flipscope {
+
+bool alignedBuffersAskForHugePages(const char* hugePagesVariable) {
+  try {
+    return hugePagePolicyFromEnvironment(hugePagesVariable).value_or(true);
+  } catch (const InputError&) {
+    return true;
+  }
+}
 
 AlignedBuffer::AlignedBuffer(std::size_t bytes) : mSize((bytes + kDirectBlock - 1) / kDirectBlock * kDirectBlock) {
   if (mSize == 0) return;
-  auto* p = static_cast<std::byte*>(std::aligned_alloc(kDirectBlock, mSize));
+  static const bool askForHugePages = alignedBuffersAskForHugePages(std::getenv("FLIPSCOPE_HUGE_PAGES"));
+  const bool huge = mSize >= kHugePageBytes && askForHugePages;
+  const std::size_t alignment = huge ? kHugePageBytes : kDirectBlock;
+  const std::size_t allocated = (mSize + alignment - 1) / alignment * alignment;
+  auto* p = static_cast<std::byte*>(std::aligned_alloc(alignment, allocated));
   if (!p) throw std::bad_alloc();
+  if (huge) adviseHugePages(p, allocated);
   mData.reset(p);
 }
 

@@ -1,12 +1,16 @@
 #include "tools/BenchDisk.h"
 
 #include <fcntl.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
+#include <optional>
 
+#include "core/AlignedBuffer.h"
 #include "core/Elapsed.h"
 #include "core/Error.h"
 
@@ -22,9 +26,34 @@ void dropFromPageCache(const std::vector<std::filesystem::path>& files) {
   }
 }
 
-DiskRead readUncached(const std::vector<std::filesystem::path>& files, std::size_t blockBytes) {
-  std::unique_ptr<void, decltype(&std::free)> buffer(std::aligned_alloc(4096, blockBytes), &std::free);
-  if (!buffer) throw InputError("bench: cannot allocate the read buffer");
+namespace {
+
+/// `bytes` of 4 KiB pages from a mapping of their own, advised against huge pages.
+class SmallPageBuffer {
+ public:
+  explicit SmallPageBuffer(std::size_t bytes) : mBytes(bytes) {
+    mData = ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (mData == MAP_FAILED) throw InputError("bench: cannot map the read buffer");
+    ::madvise(mData, bytes, MADV_NOHUGEPAGE);
+  }
+  ~SmallPageBuffer() { ::munmap(mData, mBytes); }
+  SmallPageBuffer(const SmallPageBuffer&) = delete;
+  SmallPageBuffer& operator=(const SmallPageBuffer&) = delete;
+  void* data() const { return mData; }
+
+ private:
+  void* mData;
+  std::size_t mBytes;
+};
+
+}  // namespace
+
+DiskRead readUncached(const std::vector<std::filesystem::path>& files, std::size_t blockBytes, ReadPages pages) {
+  std::optional<AlignedBuffer> huge;
+  std::optional<SmallPageBuffer> small;
+  void* const buffer =
+      pages == ReadPages::Huge ? static_cast<void*>(huge.emplace(blockBytes).data()) : small.emplace(blockBytes).data();
+  std::memset(buffer, 0, blockBytes);  // its pages in place before the clock starts
   DiskRead result;
   result.direct = true;
   dropFromPageCache(files);  // also for the O_DIRECT read: no dirty pages of the files left
@@ -37,7 +66,7 @@ DiskRead readUncached(const std::vector<std::filesystem::path>& files, std::size
     }
     if (fd < 0) throw FileError(file, "cannot open");
     for (;;) {
-      const ssize_t n = ::read(fd, buffer.get(), blockBytes);
+      const ssize_t n = ::read(fd, buffer, blockBytes);
       if (n < 0) {
         ::close(fd);
         throw FileError(file, "read failed");

@@ -1,5 +1,6 @@
 // Huge page advice: the policy's values, the decision, and the advice reaching the kernel (the
-// mapping's VmFlags in /proc/self/smaps carry "hg" once advised MADV_HUGEPAGE).
+// mapping's VmFlags in /proc/self/smaps carry "hg" once advised MADV_HUGEPAGE); direct-I/O
+// buffers (AlignedBuffer) of a huge page or more in whole, advised huge pages.
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/mman.h>
@@ -8,6 +9,8 @@
 
 #include <chrono>
 #include <cstdint>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -15,6 +18,7 @@
 #include <string>
 
 #include "TestSupport.h"
+#include "core/AlignedBuffer.h"
 #include "core/AtomicFile.h"
 #include "core/Error.h"
 #include "core/HugePageAdvice.h"
@@ -188,6 +192,33 @@ TEST(HugePageAdvice, AnAllocationsPagesAreAdvisedFromItsFirstPageOn) {
   EXPECT_NE(vmFlagsAt(bytes).find(" hg"), std::string::npos) << vmFlagsAt(bytes);
   EXPECT_NE(vmFlagsAt(bytes + kBytes - 1).find(" hg"), std::string::npos) << vmFlagsAt(bytes + kBytes - 1);
   ::munmap(map, kBytes);
+}
+
+TEST(HugePageAdvice, DirectIoBuffersAskForHugePagesUnlessTheVariableSaysOff) {
+  EXPECT_TRUE(alignedBuffersAskForHugePages(nullptr));
+  EXPECT_TRUE(alignedBuffersAskForHugePages("auto"));
+  EXPECT_TRUE(alignedBuffersAskForHugePages("on"));
+  EXPECT_TRUE(alignedBuffersAskForHugePages("bogus")) << "main() reports it; a buffer does not throw";
+  EXPECT_FALSE(alignedBuffersAskForHugePages("off"));
+}
+
+TEST(HugePageAdvice, ADirectIoBufferOfAHugePageOrMoreIsWholeAdvisedHugePages) {
+  const bool asked = alignedBuffersAskForHugePages(std::getenv("FLIPSCOPE_HUGE_PAGES"));
+  for (const std::size_t bytes : {kHugePageBytes, kHugePageBytes + 1, 3 * kHugePageBytes - 4096}) {
+    AlignedBuffer buffer(bytes);
+    ASSERT_NE(buffer.data(), nullptr);
+    EXPECT_EQ(buffer.size(), (bytes + kDirectBlock - 1) / kDirectBlock * kDirectBlock);
+    const auto address = reinterpret_cast<std::uintptr_t>(buffer.data());
+    EXPECT_EQ(address % (asked ? kHugePageBytes : kDirectBlock), 0u) << bytes;
+    std::memset(buffer.data(), 7, buffer.size());  // all of it is the buffer's
+    if (asked && transparentHugePagesAvailable()) {
+      EXPECT_NE(vmFlagsAt(buffer.data()).find(" hg"), std::string::npos) << vmFlagsAt(buffer.data());
+      EXPECT_NE(vmFlagsAt(buffer.data() + buffer.size() - 1).find(" hg"), std::string::npos) << bytes;
+    }
+  }
+  AlignedBuffer small(kHugePageBytes - kDirectBlock);  // under a huge page: blocks, as before
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(small.data()) % kDirectBlock, 0u);
+  EXPECT_EQ(small.size(), kHugePageBytes - kDirectBlock);
 }
 
 }  // namespace

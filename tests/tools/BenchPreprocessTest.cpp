@@ -31,8 +31,9 @@ TEST(BenchPreprocess, EachDiskRunsConvertsAreHeldAgainstItsOwnDiskRead) {
     for (std::size_t r = 0; r < runs.size(); ++r) {
       const auto& one = runs.at(r);
       const double disk = one.at("disk_read_s").get<double>();
-      EXPECT_DOUBLE_EQ(disk, std::min(one.at("disk_read_16m_s").get<double>(), one.at("disk_read_2m_s").get<double>()))
-          << "the faster read is the disk's";
+      EXPECT_DOUBLE_EQ(disk, std::min({one.at("disk_read_16m_s").get<double>(), one.at("disk_read_2m_s").get<double>(),
+                                       one.at("disk_read_2m_small_pages_s").get<double>()}))
+          << "the fastest read is the disk's";
       EXPECT_GT(one.at(seconds).get<double>(), 0.0) << convert << " run " << r;
       ratios.push_back(one.at(seconds).get<double>() / disk);
     }
@@ -64,8 +65,9 @@ TEST(BenchPreprocess, OneDiskRunByDefaultWhoseFiguresAreAlsoAtTheTop) {
   ASSERT_EQ(j.at("disk_runs").size(), 1u) << run.output;
   const auto& only = j.at("disk_runs").at(0);
   for (const auto& [key, value] : only.items()) EXPECT_EQ(j.at(key), value) << key;
-  for (const char* key : {"disk_read_s", "disk_read_16m_s", "disk_read_2m_s", "disk_read_direct",
-                          "convert_from_disk_in_core_s", "convert_from_disk_one_read_out_of_core_s"})
+  for (const char* key :
+       {"disk_read_s", "disk_read_16m_s", "disk_read_2m_s", "disk_read_2m_small_pages_s", "disk_read_direct",
+        "convert_from_disk_in_core_s", "convert_from_disk_one_read_out_of_core_s"})
     EXPECT_TRUE(only.contains(key)) << key;
   const auto& inCore = j.at("disk_summary").at("convert_from_disk_in_core_x_disk_read");
   EXPECT_DOUBLE_EQ(inCore.at("median").get<double>(),
