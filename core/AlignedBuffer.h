@@ -17,13 +17,22 @@ inline constexpr std::size_t kDirectBlock = 4096;
 /// main() reports it).
 bool alignedBuffersAskForHugePages(const char* hugePagesVariable);
 
-/// A heap buffer aligned to kDirectBlock. One of kHugePageBytes or more starts on a huge page's
-/// boundary, spans whole huge pages and asks for them (MADV_HUGEPAGE), unless FLIPSCOPE_HUGE_PAGES
-/// is off, whatever the first-touch advice of the process: on the development VM (virtio disk) a
+/// AlignedBuffers of kHugePageBytes up to this size ask for huge pages whatever the process's
+/// first-touch advice (hugePageAdviceOn); larger ones only where it is on: on a VM where huge
+/// pages fill slowly (core/HugePageAdvice.h), hundreds of megabytes of them would cost more at
+/// their first touch than their reads save. The read-ahead's pieces and the spill files' buffers
+/// are 2 MiB or less; a spill bucket's record buffer may be hundreds of megabytes.
+inline constexpr std::size_t kAlwaysHugeBufferBytes = std::size_t(32) << 20;
+
+/// A heap buffer aligned to kDirectBlock. One of kHugePageBytes or more (see
+/// kAlwaysHugeBufferBytes) starts on a huge page's boundary, spans whole huge pages and asks for
+/// them (MADV_HUGEPAGE), unless FLIPSCOPE_HUGE_PAGES is off: on the development VM (virtio disk) a
 /// direct read into huge pages took half as long as one into 4 KiB pages, whose every page the
 /// device maps (1.2 GB in 2 MiB reads: 0.41 to 0.45 s against 0.88 to 0.93 s, alternating,
 /// 2026-12-07), and convert's read of an uncached 100 M particle frame, spacing and domain given,
-/// took 0.74 to 0.89 s against 1.24 to 1.63 s.
+/// took 0.74 to 0.89 s against 1.24 to 1.63 s. The rounding adds less than a huge page. The heap
+/// range such a buffer leaves on free keeps its advice, so later allocations there may be given
+/// huge pages too.
 class AlignedBuffer {
  public:
   AlignedBuffer() = default;

@@ -27,7 +27,8 @@
 // convert took 0.07 s against 0.09 s measuring each time (eight runs each, alternating).
 //
 // FLIPSCOPE_HUGE_PAGES=on|off|auto (default auto: measure, or what this boot measured) overrides
-// the measurement.
+// the measurement. Direct-I/O buffers (core/AlignedBuffer.h) of 2 to 32 MiB ask for huge pages
+// whatever was measured, for their reads' sake; off turns that off too.
 #pragma once
 
 #include <cstddef>

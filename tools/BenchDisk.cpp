@@ -9,6 +9,7 @@
 #include <cstring>
 #include <memory>
 #include <optional>
+#include <string>
 
 #include "core/AlignedBuffer.h"
 #include "core/Elapsed.h"
@@ -49,6 +50,9 @@ class SmallPageBuffer {
 }  // namespace
 
 DiskRead readUncached(const std::vector<std::filesystem::path>& files, std::size_t blockBytes, ReadPages pages) {
+  if (blockBytes == 0 || blockBytes % kDirectBlock != 0)
+    throw InputError("bench: a direct read's size is a whole number of 4 KiB blocks, not " +
+                     std::to_string(blockBytes));
   std::optional<AlignedBuffer> huge;
   std::optional<SmallPageBuffer> small;
   void* const buffer =

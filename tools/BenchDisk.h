@@ -26,8 +26,8 @@ struct DiskRead {
 /// 0.45 s against 0.88 to 0.93 s, 2 MiB reads, alternating (2026-12-07): the device maps a
 /// buffer page by page.
 enum class ReadPages {
-  Huge,   ///< an AlignedBuffer: huge pages where the kernel gives them (convert's own reads)
-  Small,  ///< 4 KiB pages (MADV_NOHUGEPAGE), as `dd iflag=direct` reads
+  Huge,   ///< an AlignedBuffer: huge pages for reads of 2 MiB up, as convert's own reads
+  Small,  ///< 4 KiB pages (MADV_NOHUGEPAGE), as `dd iflag=direct` reads where THP is not "always"
 };
 
 /// Reads every file once from the disk: with O_DIRECT in aligned reads of `blockBytes` (a

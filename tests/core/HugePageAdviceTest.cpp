@@ -212,13 +212,34 @@ TEST(HugePageAdvice, ADirectIoBufferOfAHugePageOrMoreIsWholeAdvisedHugePages) {
     EXPECT_EQ(address % (asked ? kHugePageBytes : kDirectBlock), 0u) << bytes;
     std::memset(buffer.data(), 7, buffer.size());  // all of it is the buffer's
     if (asked && transparentHugePagesAvailable()) {
+      // Whole huge pages: the last byte of the last one is advised too.
+      const std::size_t whole = (buffer.size() + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
       EXPECT_NE(vmFlagsAt(buffer.data()).find(" hg"), std::string::npos) << vmFlagsAt(buffer.data());
-      EXPECT_NE(vmFlagsAt(buffer.data() + buffer.size() - 1).find(" hg"), std::string::npos) << bytes;
+      EXPECT_NE(vmFlagsAt(buffer.data() + whole - 1).find(" hg"), std::string::npos) << bytes;
     }
   }
   AlignedBuffer small(kHugePageBytes - kDirectBlock);  // under a huge page: blocks, as before
   EXPECT_EQ(reinterpret_cast<std::uintptr_t>(small.data()) % kDirectBlock, 0u);
   EXPECT_EQ(small.size(), kHugePageBytes - kDirectBlock);
+}
+
+TEST(HugePageAdvice, ADirectIoBufferPastThirtyTwoMegabytesFollowsTheProcesssAdvice) {
+  if (!alignedBuffersAskForHugePages(std::getenv("FLIPSCOPE_HUGE_PAGES")) || !transparentHugePagesAvailable())
+    GTEST_SKIP() << "direct-I/O buffers ask for no huge pages here (FLIPSCOPE_HUGE_PAGES=off, or THP off)";
+  const bool before = hugePageAdviceOn();
+  constexpr std::size_t kBytes = kAlwaysHugeBufferBytes + (std::size_t(8) << 20);  // a fresh mapping
+  setHugePageAdvice(false);
+  {
+    AlignedBuffer buffer(kBytes);
+    EXPECT_EQ(vmFlagsAt(buffer.data() + kBytes / 2).find(" hg"), std::string::npos) << vmFlagsAt(buffer.data());
+  }
+  setHugePageAdvice(true);
+  {
+    AlignedBuffer buffer(kBytes);
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(buffer.data()) % kHugePageBytes, 0u);
+    EXPECT_NE(vmFlagsAt(buffer.data() + kBytes / 2).find(" hg"), std::string::npos) << vmFlagsAt(buffer.data());
+  }
+  setHugePageAdvice(before);
 }
 
 }  // namespace
